@@ -1,0 +1,282 @@
+r"""Rotation algebra for SO(2) and SO(3).
+
+Finite rotations are stored as rotation tensors (or unit quaternions) and are
+updated *multiplicatively*, never by adding rotation vectors (seed §2.1;
+Argyris 1982; Simo & Vu-Quoc 1986; Crisfield 1997, ch. 16–17):
+
+.. math::
+
+    \mathbf R^{n+1} = \exp(\mathrm{spin}(\Delta\boldsymbol\theta))\,\mathbf R^n ,
+
+with the exponential map given by the Rodrigues formula
+
+.. math::
+
+    \exp(\boldsymbol\Theta) = \mathbf I + \frac{\sin\theta}{\theta}\boldsymbol\Theta
+        + \frac{1-\cos\theta}{\theta^2}\boldsymbol\Theta^2,
+    \qquad \boldsymbol\Theta = \mathrm{spin}(\boldsymbol\theta),\ \theta = \|\boldsymbol\theta\| .
+
+Every coefficient that is 0/0 at :math:`\theta = 0` is evaluated by its Taylor
+series below :math:`\theta = 10^{-3}` (next omitted term below 1e-19), so the
+maps are accurate to rounding for every angle, including 1e-12.
+
+The logarithm goes through the quaternion of ``R`` (Spurrier's branch-free
+choice of the largest diagonal term), which stays accurate near
+:math:`\theta = \pi`, where the usual formula ``arccos((tr R − 1)/2)`` loses
+half of its digits.
+
+Tangent operator (spatial form): for :math:`\mathbf R = \exp(\boldsymbol\theta)`,
+:math:`\delta\mathbf R\,\mathbf R^T = \mathrm{spin}(\mathbf T(\boldsymbol\theta)\,\delta\boldsymbol\theta)` with
+
+.. math::
+
+    \mathbf T(\boldsymbol\theta) = \mathbf I + \frac{1-\cos\theta}{\theta^2}\boldsymbol\Theta
+        + \frac{\theta-\sin\theta}{\theta^3}\boldsymbol\Theta^2 ,\qquad
+    \mathbf T^{-1}(\boldsymbol\theta) = \mathbf I - \tfrac12\boldsymbol\Theta
+        + \frac{1}{\theta^2}\Bigl(1-\frac{\theta}{2}\cot\frac{\theta}{2}\Bigr)\boldsymbol\Theta^2
+
+(Ibrahimbegović, Frey & Kožar 1995; Crisfield 1997, eq. 16.119). The material
+form is :math:`\mathbf T^T`.
+
+SO(2) is commutative: :math:`\exp(\Delta\theta)\exp(\theta) = \exp(\theta+\Delta\theta)`,
+so the multiplicative update of a planar rotation is the addition of angles,
+and the stored angle may grow past :math:`2\pi` without loss (a beam rolled
+into two turns stores :math:`4\pi` at its tip).
+
+All functions are numba-compiled (``cache=True``) so that element kernels can
+call them; they take and return plain numpy arrays: vectors ``(3,)``,
+matrices ``(3, 3)``, quaternions ``(4,)`` as ``(w, x, y, z)``.
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+__all__ = [
+    "spin", "axial", "exp_so3", "log_so3", "tangent_so3", "tangent_inv_so3",
+    "compose", "update_so3", "quat_from_rotvec", "quat_to_matrix", "quat_from_matrix",
+    "quat_mul", "quat_update", "rotvec_from_quat", "exp_so2", "log_so2", "update_so2",
+    "orthogonality_error",
+]
+
+_SMALL = 1e-3  # below this angle the 0/0 coefficients use their Taylor series
+
+
+@numba.njit(cache=True)
+def spin(w):
+    """Skew-symmetric matrix of ``w`` (3,): ``spin(w) @ v == cross(w, v)``."""
+    W = np.zeros((3, 3))
+    W[0, 1] = -w[2]
+    W[0, 2] = w[1]
+    W[1, 0] = w[2]
+    W[1, 2] = -w[0]
+    W[2, 0] = -w[1]
+    W[2, 1] = w[0]
+    return W
+
+
+@numba.njit(cache=True)
+def axial(W):
+    """Axial vector (3,) of the skew part of ``W`` (3, 3); inverse of :func:`spin`."""
+    return 0.5 * np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]])
+
+
+@numba.njit(cache=True)
+def _exp_coefficients(t):
+    """a = sin t / t, b = (1 - cos t)/t², both accurate for every t ≥ 0."""
+    if t < _SMALL:
+        t2 = t * t
+        return 1.0 - t2 / 6.0 + t2 * t2 / 120.0, 0.5 - t2 / 24.0 + t2 * t2 / 720.0
+    s = np.sin(0.5 * t)
+    # 1 - cos t = 2 sin²(t/2) has no cancellation
+    return np.sin(t) / t, 2.0 * s * s / (t * t)
+
+
+@numba.njit(cache=True)
+def exp_so3(w):
+    """Rotation tensor (3, 3) of the rotation vector ``w`` (3,) (Rodrigues formula)."""
+    t = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    a, b = _exp_coefficients(t)
+    W = spin(w)
+    return np.eye(3) + a * W + b * (W @ W)
+
+
+@numba.njit(cache=True)
+def quat_from_matrix(R):
+    """Unit quaternion (4,) ``(w, x, y, z)`` of ``R`` (3, 3), with w ≥ 0 (Spurrier 1978)."""
+    tr = R[0, 0] + R[1, 1] + R[2, 2]
+    q = np.empty(4)
+    m = max(tr, R[0, 0], R[1, 1], R[2, 2])
+    if m == tr:
+        q[0] = 0.5 * np.sqrt(1.0 + tr)
+        f = 0.25 / q[0]
+        q[1] = (R[2, 1] - R[1, 2]) * f
+        q[2] = (R[0, 2] - R[2, 0]) * f
+        q[3] = (R[1, 0] - R[0, 1]) * f
+    else:
+        i = 0
+        if R[1, 1] == m:
+            i = 1
+        elif R[2, 2] == m:
+            i = 2
+        j = (i + 1) % 3
+        k = (i + 2) % 3
+        qi = 0.5 * np.sqrt(1.0 + 2.0 * R[i, i] - tr)
+        f = 0.25 / qi
+        q[1 + i] = qi
+        q[0] = (R[k, j] - R[j, k]) * f
+        q[1 + j] = (R[j, i] + R[i, j]) * f
+        q[1 + k] = (R[k, i] + R[i, k]) * f
+    if q[0] < 0.0:
+        q = -q
+    return q / np.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2 + q[3] ** 2)
+
+
+@numba.njit(cache=True)
+def rotvec_from_quat(q):
+    """Rotation vector (3,) of the unit quaternion ``q`` (4,), with norm in [0, π]."""
+    w = q[0]
+    v = q[1:4].copy()
+    if w < 0.0:
+        w = -w
+        v = -v
+    s = np.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2)
+    t = 2.0 * np.arctan2(s, w)  # in [0, π]
+    if s < 1e-8:
+        # t/s = 2/w (1 + s²/(3w²)) + O(s⁴): exact to rounding here
+        return v * (2.0 / w) * (1.0 + s * s / (3.0 * w * w))
+    return v * (t / s)
+
+
+@numba.njit(cache=True)
+def log_so3(R):
+    """Rotation vector (3,) of ``R`` (3, 3), with norm in [0, π]; robust near 0 and π."""
+    return rotvec_from_quat(quat_from_matrix(R))
+
+
+@numba.njit(cache=True)
+def tangent_so3(w):
+    """Spatial tangent operator T(w) (3, 3): δR Rᵀ = spin(T(w) δw) for R = exp(w)."""
+    t = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    W = spin(w)
+    if t < _SMALL:
+        t2 = t * t
+        b = 0.5 - t2 / 24.0 + t2 * t2 / 720.0
+        c = 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0
+    else:
+        s = np.sin(0.5 * t)
+        b = 2.0 * s * s / (t * t)
+        c = (t - np.sin(t)) / (t * t * t)
+    return np.eye(3) + b * W + c * (W @ W)
+
+
+@numba.njit(cache=True)
+def tangent_inv_so3(w):
+    """Inverse of :func:`tangent_so3` (3, 3); singular only at |w| = 2π, 4π, …"""
+    t = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    W = spin(w)
+    if t < _SMALL:
+        t2 = t * t
+        c = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0
+    else:
+        h = 0.5 * t
+        c = (1.0 - h * np.cos(h) / np.sin(h)) / (t * t)
+    return np.eye(3) - 0.5 * W + c * (W @ W)
+
+
+@numba.njit(cache=True)
+def compose(R1, R2):
+    """Composition R1·R2 (3, 3): first R2, then R1."""
+    return R1 @ R2
+
+
+@numba.njit(cache=True)
+def update_so3(R, dtheta):
+    """Multiplicative (spatial) update ``exp(spin(dtheta)) @ R`` (3, 3)."""
+    return exp_so3(dtheta) @ R
+
+
+@numba.njit(cache=True)
+def quat_from_rotvec(w):
+    """Unit quaternion (4,) of the rotation vector ``w`` (3,)."""
+    t = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    h = 0.5 * t
+    if t < _SMALL:
+        t2 = t * t
+        f = 0.5 - t2 / 48.0 + t2 * t2 / 3840.0  # sin(t/2)/t
+    else:
+        f = np.sin(h) / t
+    q = np.empty(4)
+    q[0] = np.cos(h)
+    q[1] = f * w[0]
+    q[2] = f * w[1]
+    q[3] = f * w[2]
+    return q
+
+
+@numba.njit(cache=True)
+def quat_mul(p, q):
+    """Quaternion product p∘q (4,): the rotation q followed by p."""
+    r = np.empty(4)
+    r[0] = p[0] * q[0] - p[1] * q[1] - p[2] * q[2] - p[3] * q[3]
+    r[1] = p[0] * q[1] + p[1] * q[0] + p[2] * q[3] - p[3] * q[2]
+    r[2] = p[0] * q[2] - p[1] * q[3] + p[2] * q[0] + p[3] * q[1]
+    r[3] = p[0] * q[3] + p[1] * q[2] - p[2] * q[1] + p[3] * q[0]
+    return r
+
+
+@numba.njit(cache=True)
+def quat_update(q, dtheta):
+    """Multiplicative update of a unit quaternion, renormalised: exp(dθ)∘q (4,)."""
+    r = quat_mul(quat_from_rotvec(dtheta), q)
+    return r / np.sqrt(r[0] ** 2 + r[1] ** 2 + r[2] ** 2 + r[3] ** 2)
+
+
+@numba.njit(cache=True)
+def quat_to_matrix(q):
+    """Rotation tensor (3, 3) of the unit quaternion ``q`` (4,)."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    R = np.empty((3, 3))
+    R[0, 0] = 1.0 - 2.0 * (y * y + z * z)
+    R[0, 1] = 2.0 * (x * y - w * z)
+    R[0, 2] = 2.0 * (x * z + w * y)
+    R[1, 0] = 2.0 * (x * y + w * z)
+    R[1, 1] = 1.0 - 2.0 * (x * x + z * z)
+    R[1, 2] = 2.0 * (y * z - w * x)
+    R[2, 0] = 2.0 * (x * z - w * y)
+    R[2, 1] = 2.0 * (y * z + w * x)
+    R[2, 2] = 1.0 - 2.0 * (x * x + y * y)
+    return R
+
+
+@numba.njit(cache=True)
+def exp_so2(theta):
+    """Planar rotation tensor (2, 2) of the angle ``theta``."""
+    c = np.cos(theta)
+    s = np.sin(theta)
+    R = np.empty((2, 2))
+    R[0, 0] = c
+    R[0, 1] = -s
+    R[1, 0] = s
+    R[1, 1] = c
+    return R
+
+
+@numba.njit(cache=True)
+def log_so2(R):
+    """Angle in (-π, π] of the planar rotation ``R`` (2, 2)."""
+    return np.arctan2(R[1, 0] - R[0, 1], R[0, 0] + R[1, 1])
+
+
+@numba.njit(cache=True)
+def update_so2(theta, dtheta):
+    """Multiplicative update exp(dθ)·exp(θ) of a planar rotation, stored as its
+    unwrapped angle: θ + dθ (SO(2) is commutative; exact)."""
+    return theta + dtheta
+
+
+def orthogonality_error(R: np.ndarray) -> float:
+    """‖RᵀR − I‖_max of one (3, 3) or many (n, 3, 3) rotation tensors."""
+    R = np.asarray(R)
+    RtR = np.einsum("...ji,...jk->...ik", R, R)
+    return float(np.max(np.abs(RtR - np.eye(R.shape[-1]))))

@@ -1,0 +1,11 @@
+"""Co-rotational frames: rigid-body motion removed by a projector.
+
+Each frame maps global nodal displacements/rotations ``d`` to deformations
+``d̄`` in an element frame that rotates with the element, and back:
+``δd̄ = P δd``, ``f = Pᵀ f̄``, ``K = Pᵀ K̄ P + ∂(Pᵀ)/∂d : f̄`` (Rankin &
+Nour-Omid 1988, 1990; seed §2.1). The element law that produces ``f̄, K̄``
+lives in :mod:`dolfinx_corot.elements` and never sees the frame.
+"""
+from . import frame2d
+
+__all__ = ["frame2d"]

@@ -1,0 +1,120 @@
+r"""Two-node line elements in the plane (beam and bar): gather ► frame ► law ► scatter.
+
+:func:`corotational` evaluates the co-rotational element (frame from
+:mod:`dolfinx_corot.corotation.frame2d`, law from
+:mod:`dolfinx_corot.elements.line2d`); :func:`linear` the geometrically linear
+element in the initial frame (no co-rotational work at all).
+
+For DOLFINx the two are wrapped in numba ``cfunc`` tabulate-tensor kernels
+(:data:`vector_kernel`, :data:`matrix_kernel`) with the ufcx signature
+``(A, w, c, coords, entity_local_index, permutation)``:
+
+* ``w`` = [state of node 1 (u, v, θ), state of node 2, props (NPROPS)],
+  where θ is the total nodal angle (node-major, as DOLFINx packs a
+  blocked space);
+* ``c`` = [large_rotations (1.0 or 0.0)];
+* ``coords`` = (2, 3) initial nodal coordinates (padded to 3).
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+from numba import types
+
+from ..corotation import frame2d
+from ..elements import line2d as law
+
+NDOF = 6
+NCOEF = NDOF + law.NPROPS
+
+
+@numba.njit(cache=True)
+def corotational(x1, y1, x2, y2, d, props, f, K, P, fbar, kbar):
+    """Co-rotational element: f (6,) internal force, K (6, 6) consistent tangent.
+
+    P (3, 6), fbar (3,), kbar (3, 3) are work arrays.
+    """
+    l0, l, c, s, ub, t1, t2 = frame2d.update(x1, y1, x2, y2, d)
+    law.basic_response(l0, ub, t1, t2, props, fbar, kbar)
+    frame2d.fill_projector(l, c, s, P)
+    frame2d.global_force(P, fbar, f)
+    frame2d.global_stiffness(l, c, s, P, kbar, fbar, K)
+
+
+@numba.njit(cache=True)
+def linear(x1, y1, x2, y2, d, props, f, K, P, fbar, kbar):
+    """Geometrically linear element in the initial frame: K = P₀ᵀ K̄ P₀, f = K d + P₀ᵀ f̄₀."""
+    l0, c0, s0 = frame2d.initial(x1, y1, x2, y2)
+    frame2d.fill_projector(l0, c0, s0, P)
+    ub = 0.0
+    t1 = 0.0
+    t2 = 0.0
+    for j in range(6):
+        ub += P[0, j] * d[j]
+        t1 += P[1, j] * d[j]
+        t2 += P[2, j] * d[j]
+    law.basic_response(l0, ub, t1, t2, props, fbar, kbar)
+    frame2d.global_force(P, fbar, f)
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for a in range(3):
+                for b in range(3):
+                    acc += P[a, i] * kbar[a, b] * P[b, j]
+            K[i, j] = acc
+
+
+@numba.njit(cache=True)
+def evaluate(x1, y1, x2, y2, d, props, large_rotations, f, K):
+    """Dispatch to :func:`corotational` or :func:`linear`."""
+    P = np.empty((3, 6))
+    fbar = np.empty(3)
+    kbar = np.empty((3, 3))
+    if large_rotations:
+        corotational(x1, y1, x2, y2, d, props, f, K, P, fbar, kbar)
+    else:
+        linear(x1, y1, x2, y2, d, props, f, K, P, fbar, kbar)
+
+
+@numba.njit(cache=True)
+def evaluate_all(X, D, props, large_rotations, F, K):
+    """All elements at once: X (n, 2, 2), D (n, 6), props (n, NPROPS) → F (n, 6), K (n, 6, 6)."""
+    P = np.empty((3, 6))
+    fbar = np.empty(3)
+    kbar = np.empty((3, 3))
+    for e in range(X.shape[0]):
+        if large_rotations:
+            corotational(X[e, 0, 0], X[e, 0, 1], X[e, 1, 0], X[e, 1, 1], D[e], props[e],
+                         F[e], K[e], P, fbar, kbar)
+        else:
+            linear(X[e, 0, 0], X[e, 0, 1], X[e, 1, 0], X[e, 1, 1], D[e], props[e],
+                   F[e], K[e], P, fbar, kbar)
+
+
+_sig = types.void(types.CPointer(types.double), types.CPointer(types.double),
+                  types.CPointer(types.double), types.CPointer(types.double),
+                  types.CPointer(types.int32), types.CPointer(types.uint8))
+
+
+@numba.njit(cache=True, inline="always")
+def _tabulate(w_, c_, coords_, f, K):
+    w = numba.carray(w_, (NCOEF,))
+    c = numba.carray(c_, (1,))
+    X = numba.carray(coords_, (2, 3))
+    evaluate(X[0, 0], X[0, 1], X[1, 0], X[1, 1], w[:NDOF], w[NDOF:], c[0] != 0.0, f, K)
+
+
+@numba.cfunc(_sig, nopython=True, cache=True)
+def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
+    """Element internal-force vector (6,) for a DOLFINx linear form."""
+    b = numba.carray(b_, (NDOF,))
+    K = np.empty((NDOF, NDOF))
+    _tabulate(w_, c_, coords_, b, K)
+
+
+@numba.cfunc(_sig, nopython=True, cache=True)
+def matrix_kernel(A_, w_, c_, coords_, entity_local_index, permutation):
+    """Element tangent (6, 6) for a DOLFINx bilinear form."""
+    A = numba.carray(A_, (NDOF, NDOF))
+    f = np.empty(NDOF)
+    _tabulate(w_, c_, coords_, f, A)

@@ -1,2 +1,19 @@
-"""dolfinx_corot: large-rotation structures and contact on DOLFINx."""
+"""dolfinx_corot: large-rotation structures and contact on DOLFINx 0.5.2.
+
+The user's model is a :class:`Scene`; a driver (:class:`LoadControl`)
+follows the load path; :func:`solve` returns a :class:`Result` with the
+per-step history.
+"""
+from . import rotations
+from .io.mesh import GroupNotFoundError, TaggedMesh, from_gmsh
+from .materials import Elastic
+from .result import History, Result
+from .scene import Scene
+from .sections import Circle, Rectangle, Section
+from .solvers import ConvergenceError, LoadControl, NewtonOptions, solve
+
 __version__ = "0.1.0"
+
+__all__ = ["Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
+           "NewtonOptions", "Rectangle", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
+           "rotations", "solve"]

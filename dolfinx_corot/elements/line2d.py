@@ -46,8 +46,12 @@ EA, EI, GAS, N0 = range(NPROPS)
 
 
 @numba.njit(cache=True, inline="always")
-def basic_response(l0, ubar, t1, t2, props, fbar, kbar):
-    """Fill fbar (3,) and kbar (3, 3) from the basic deformations."""
+def basic_response(l0, ubar, t1, t2, props, fbar, kbar, shallow_arch):
+    """Fill fbar (3,) and kbar (3, 3) from the basic deformations.
+
+    shallow_arch: include the bending part of the axial strain (co-rotational
+    analysis); False gives the linear law of a geometrically linear analysis.
+    """
     ea = props[EA]
     ei = props[EI]
     gas = props[GAS]
@@ -55,7 +59,7 @@ def basic_response(l0, ubar, t1, t2, props, fbar, kbar):
     k = ei / (l0 * (1.0 + phi))
     kd = k * (4.0 + phi)
     ko = k * (2.0 - phi)
-    if ei > 0.0:
+    if shallow_arch and ei > 0.0:
         # shallow-arch coupling: ∂ε̄/∂(ū, θ̄1, θ̄2)
         g0 = 1.0 / l0
         g1 = (4.0 * t1 - t2) / 30.0
@@ -81,7 +85,7 @@ def basic_response(l0, ubar, t1, t2, props, fbar, kbar):
     kbar[2, 2] = eal * g2 * g2 + kd
     kbar[1, 2] = eal * g1 * g2 + ko
     kbar[2, 1] = kbar[1, 2]
-    if ei > 0.0:
+    if shallow_arch and ei > 0.0:
         kbar[1, 1] += 4.0 * nl / 30.0
         kbar[2, 2] += 4.0 * nl / 30.0
         kbar[1, 2] -= nl / 30.0

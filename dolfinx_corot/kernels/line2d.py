@@ -35,7 +35,7 @@ def corotational(x1, y1, x2, y2, d, props, f, K, P, fbar, kbar):
     P (3, 6), fbar (3,), kbar (3, 3) are work arrays.
     """
     l0, l, c, s, ub, t1, t2 = frame2d.update(x1, y1, x2, y2, d)
-    law.basic_response(l0, ub, t1, t2, props, fbar, kbar)
+    law.basic_response(l0, ub, t1, t2, props, fbar, kbar, True)
     frame2d.fill_projector(l, c, s, P)
     frame2d.global_force(P, fbar, f)
     frame2d.global_stiffness(l, c, s, P, kbar, fbar, K)
@@ -53,7 +53,7 @@ def linear(x1, y1, x2, y2, d, props, f, K, P, fbar, kbar):
         ub += P[0, j] * d[j]
         t1 += P[1, j] * d[j]
         t2 += P[2, j] * d[j]
-    law.basic_response(l0, ub, t1, t2, props, fbar, kbar)
+    law.basic_response(l0, ub, t1, t2, props, fbar, kbar, False)
     frame2d.global_force(P, fbar, f)
     for i in range(6):
         for j in range(6):

@@ -1,0 +1,181 @@
+"""Residual and Jacobian assembly into PETSc through DOLFINx.
+
+This is the only module that touches DOLFINx's C++ layer: a numba ``cfunc``
+element kernel (ufcx ``tabulate_tensor`` signature) becomes a
+``dolfinx.cpp.fem.Form_float64`` on the part's function space, so DOLFINx
+handles dofmaps, ghosts, sparsity and Dirichlet rows (dolfinx-0.5 notes §2).
+
+:class:`System` is what the solvers see: a residual
+:math:`\\mathbf r(\\mathbf x, \\lambda) = \\lambda\\mathbf f_{ext} - \\mathbf f_{int}(\\mathbf x)`,
+its Jacobian, a linear solve and an update rule; it knows nothing about
+beams. Newton increments are homogeneous on supported dofs.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Protocol, Sequence
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx
+import dolfinx.cpp
+import dolfinx.fem
+import dolfinx.fem.petsc
+import dolfinx.mesh
+
+
+def kernel_form(V: dolfinx.fem.FunctionSpace, kernel_address: int, rank: int,
+                coefficients: Sequence[dolfinx.fem.Function], constants: Sequence[dolfinx.fem.Constant],
+                cells: np.ndarray | None = None):
+    """A DOLFINx form whose cell integral is a compiled kernel.
+
+    V: the argument space (test, and trial for rank 2); kernel_address: the
+    address of a numba cfunc; coefficients are packed into ``w`` in order,
+    constants into ``c``; cells: owned cells to integrate over (all if None).
+    """
+    mesh = V.mesh
+    if cells is None:
+        integrals = {dolfinx.cpp.fem.IntegralType.cell: ([(-1, kernel_address)], None)}
+    else:
+        tdim = mesh.topology.dim
+        cells = np.unique(np.asarray(cells, dtype=np.int32))
+        tags = dolfinx.mesh.meshtags(mesh, tdim, cells, np.ones(len(cells), dtype=np.int32))
+        integrals = {dolfinx.cpp.fem.IntegralType.cell: ([(1, kernel_address)], tags)}
+    spaces = [V._cpp_object] * rank
+    return dolfinx.cpp.fem.Form_float64(spaces, integrals, [c._cpp_object for c in coefficients],
+                                        [c._cpp_object for c in constants], False)
+
+
+class Model(Protocol):
+    """What :class:`System` needs from the assembled part(s)."""
+
+    V: dolfinx.fem.FunctionSpace
+
+    def forms(self) -> tuple[object, object]: ...            # (vector form, matrix form)
+    def dirichlet_bcs(self) -> list: ...                        # DOLFINx DirichletBCs (homogeneous)
+    def external_force(self, b: PETSc.Vec) -> None: ...         # fill the reference load vector
+    def update(self, dx: PETSc.Vec) -> None: ...                # x ← x ⊕ dx
+    def checkpoint(self) -> object: ...
+    def restore(self, cp: object) -> None: ...
+
+
+@dataclass
+class Timings:
+    """Accumulated wall time (s) of the phases of the Newton iterations."""
+
+    assembly: float = 0.0
+    solve: float = 0.0
+    update: float = 0.0
+
+    def copy(self) -> "Timings":
+        return Timings(self.assembly, self.solve, self.update)
+
+
+class System:
+    """Nonlinear system r(x, λ) = λ f_ext − f_int(x) = 0 of one model.
+
+    The linear solver is MUMPS LU by default; PETSc options with the prefix
+    ``dc_newton_`` override it (e.g. ``-dc_newton_ksp_type gmres``).
+    """
+
+    def __init__(self, model: Model, options_prefix: str = "dc_newton_"):
+        self.model = model
+        self.comm = model.V.mesh.comm
+        self.L, self.a = model.forms()
+        self.bcs = model.dirichlet_bcs()
+        self.A = dolfinx.fem.petsc.create_matrix(self.a)
+        self.b = dolfinx.fem.petsc.create_vector(self.L)
+        self.fint = self.b.duplicate()
+        self.dx = self.b.duplicate()
+        self.fext = self.b.duplicate()
+        with self.fext.localForm() as f:
+            f.set(0.0)
+        model.external_force(self.fext)
+        self.fext.assemble()
+        self._fext_norm = self.fext.norm()
+        self.timings = Timings()
+
+        self.ksp = PETSc.KSP().create(self.comm)
+        self.ksp.setOptionsPrefix(options_prefix)
+        self.ksp.setType("preonly")
+        pc = self.ksp.getPC()
+        pc.setType("lu")
+        pc.setFactorSolverType("mumps")
+        self.ksp.setFromOptions()
+        self.ksp.setOperators(self.A)
+
+    # -- residual -----------------------------------------------------------
+    def residual(self, load_factor: float) -> tuple[float, float]:
+        """Assemble b = λ f_ext − f_int with zero rows on supported dofs.
+
+        Returns (‖b‖, reference force norm) where the reference is the larger
+        of ‖λ f_ext‖ and ‖f_int‖ over all dofs (reactions included).
+        """
+        t = time.perf_counter()
+        with self.fint.localForm() as f:
+            f.set(0.0)
+        dolfinx.fem.petsc.assemble_vector(self.fint, self.L)
+        self.fint.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        ref = max(abs(load_factor) * self._fext_norm, self.fint.norm())
+        self.fext.copy(self.b)
+        self.b.scale(load_factor)
+        self.b.axpy(-1.0, self.fint)
+        dolfinx.fem.petsc.set_bc(self.b, self.bcs)
+        norm = self.b.norm()
+        self.timings.assembly += time.perf_counter() - t
+        return norm, ref
+
+    def jacobian(self) -> None:
+        """Assemble the tangent K = ∂f_int/∂x, identity rows/columns on supports."""
+        t = time.perf_counter()
+        self.A.zeroEntries()
+        dolfinx.fem.petsc.assemble_matrix(self.A, self.a, bcs=self.bcs)
+        self.A.assemble()
+        self.timings.assembly += time.perf_counter() - t
+
+    def solve(self) -> float:
+        """Solve K dx = b; return ‖dx‖."""
+        t = time.perf_counter()
+        self.ksp.solve(self.b, self.dx)
+        reason = self.ksp.getConvergedReason()
+        self.timings.solve += time.perf_counter() - t
+        if reason < 0:
+            raise np.linalg.LinAlgError(f"linear solve failed (PETSc reason {reason}); "
+                                        "the tangent may be singular (a missing support?)")
+        return self.dx.norm()
+
+    def update(self) -> None:
+        """x ← x ⊕ dx through the model's update rule (multiplicative for rotations)."""
+        t = time.perf_counter()
+        self.model.update(self.dx)
+        self.timings.update += time.perf_counter() - t
+
+    def checkpoint(self):
+        return self.model.checkpoint()
+
+    def restore(self, cp) -> None:
+        self.model.restore(cp)
+
+    def reactions(self) -> PETSc.Vec:
+        """f_int − λ f_ext at the last residual, i.e. the support reactions (ghosted vector)."""
+        return self.fint
+
+    def destroy(self) -> None:
+        for obj in (self.ksp, self.A, self.b, self.fint, self.dx, self.fext):
+            obj.destroy()
+
+
+def owned_dofs_of_vertices(V: dolfinx.fem.FunctionSpace, vertices: np.ndarray) -> np.ndarray:
+    """Owned block indices (nodes) of V at the given local mesh vertices."""
+    blocks = dolfinx.fem.locate_dofs_topological(V, 0, vertices)
+    return blocks[blocks < V.dofmap.index_map.size_local]
+
+
+def global_sum(comm: MPI.Comm, value: np.ndarray) -> np.ndarray:
+    """Sum of an array over all ranks."""
+    out = np.zeros_like(value)
+    comm.Allreduce(np.ascontiguousarray(value), out, op=MPI.SUM)
+    return out

@@ -1,0 +1,27 @@
+"""Materials (frozen dataclasses; units are the user's consistent set)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Elastic:
+    """Isotropic linear elastic material.
+
+    E: Young's modulus (> 0); nu: Poisson's ratio in (-1, 0.5).
+    """
+
+    E: float
+    nu: float = 0.0
+
+    def __post_init__(self):
+        if not (math.isfinite(self.E) and self.E > 0.0):
+            raise ValueError(f"Elastic: Young's modulus E = {self.E} must be positive and finite")
+        if not (-1.0 < self.nu < 0.5):
+            raise ValueError(f"Elastic: Poisson's ratio nu = {self.nu} must lie in (-1, 0.5)")
+
+    @property
+    def G(self) -> float:
+        """Shear modulus E / (2 (1 + ν))."""
+        return self.E / (2.0 * (1.0 + self.nu))

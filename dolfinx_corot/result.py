@@ -1,0 +1,62 @@
+"""Results: the per-step history of an analysis."""
+from __future__ import annotations
+
+import csv
+import json
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class History:
+    """One row per converged step (load factor, monitored dofs, iterations, timings)."""
+
+    rows: list[dict] = field(default_factory=list)
+
+    def append(self, row: dict) -> None:
+        self.rows.append(dict(row))
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    @property
+    def columns(self) -> list[str]:
+        cols: list[str] = []
+        for r in self.rows:
+            cols += [k for k in r if k not in cols]
+        return cols
+
+    def column(self, name: str) -> np.ndarray:
+        """Values of one column as an array (nan where a row lacks it)."""
+        if self.rows and all(name not in r for r in self.rows):
+            raise KeyError(f"no column '{name}' in the history; columns: {self.columns}")
+        return np.array([r.get(name, np.nan) for r in self.rows], dtype=float)
+
+    def to_csv(self, path: str) -> None:
+        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+        cols = self.columns
+        with open(path, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=cols)
+            w.writeheader()
+            for r in self.rows:
+                w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
+
+
+@dataclass
+class Result:
+    """History plus totals of one analysis."""
+
+    history: History
+    completed: bool = True
+    message: str = ""
+    totals: dict = field(default_factory=dict)
+
+    def write(self, directory: str, name: str = "history") -> str:
+        """Write ``<directory>/<name>.csv`` and a JSON summary; returns the CSV path."""
+        path = os.path.join(directory, f"{name}.csv")
+        self.history.to_csv(path)
+        with open(os.path.join(directory, f"{name}_summary.json"), "w") as f:
+            json.dump({"completed": self.completed, "message": self.message, **self.totals}, f, indent=1)
+        return path

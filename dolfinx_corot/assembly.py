@@ -153,6 +153,10 @@ class System:
         self.model.update(self.dx)
         self.timings.update += time.perf_counter() - t
 
+    def state_norm(self) -> float:
+        """‖x‖ of the configuration (displacements and rotation increments mixed)."""
+        return self.model.state.vector.norm()
+
     def checkpoint(self):
         return self.model.checkpoint()
 

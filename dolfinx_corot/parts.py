@@ -155,6 +155,14 @@ class Frame2D:
         self.state.x.array[:] = cp
 
     # -- read-out -------------------------------------------------------------
+    def nodes(self) -> tuple[np.ndarray, np.ndarray]:
+        """(X (n, 2) initial positions, state (n, 3) = ux, uy, rz) of all nodes, on every rank."""
+        n_owned = self.V.dofmap.index_map.size_local
+        X = self.V.tabulate_dof_coordinates()[:n_owned, :2]
+        state = self.state.x.array.reshape(-1, 3)[:n_owned]
+        comm = self.V.mesh.comm
+        return np.concatenate(comm.allgather(X)), np.concatenate(comm.allgather(state))
+
     def nodal_values(self, where: str) -> np.ndarray:
         """(ux, uy, rz) of the first node of group ``where``, identical on every rank."""
         blocks = assembly.owned_dofs_of_vertices(self.V, self.tmesh.vertices(where))

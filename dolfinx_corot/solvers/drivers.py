@@ -47,12 +47,13 @@ class LoadControl:
         return lf
 
 
-def solve(scene, driver: LoadControl, system: System | None = None) -> Result:
+def solve(scene, driver: LoadControl, system: System | None = None, on_step=None) -> Result:
     """Run ``driver`` on ``scene``; returns a :class:`Result`.
 
     On a step that fails after all cuts, raises :class:`ConvergenceError`
     whose ``result`` holds every converged step, and the configuration is
-    left at the last converged state.
+    left at the last converged state. ``on_step(row)`` is called after every
+    converged step with its history row (e.g. to store snapshots).
     """
     own_system = system is None
     if own_system:
@@ -99,6 +100,8 @@ def solve(scene, driver: LoadControl, system: System | None = None) -> Result:
                 logger.info("step %d: lambda = %.6g, %d iterations, |r|: %s", step, lam, report.iterations,
                             row["residuals"])
                 cuts = max(cuts - 1, 0)
+                if on_step is not None:
+                    on_step(row)
     finally:
         if own_system:
             system.destroy()

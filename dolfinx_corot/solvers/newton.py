@@ -29,11 +29,13 @@ class ConvergenceError(RuntimeError):
 
 @dataclass(frozen=True)
 class NewtonOptions:
-    """rtol, atol: residual tolerances (force units); max_iterations per attempt;
+    """rtol, atol: residual tolerances (relative, force units); xtol: relative size of a
+    correction at round-off level; max_iterations per attempt;
     divergence_factor: ‖r‖ above this multiple of its initial value is divergence."""
 
-    rtol: float = 1e-10
+    rtol: float = 1e-9
     atol: float = 1e-12
+    xtol: float = 1e-13
     max_iterations: int = 25
     divergence_factor: float = 1e6
 
@@ -63,9 +65,10 @@ def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions())
     norm, ref = system.residual(load_factor)
     report.residuals.append(norm)
     first = norm
+    floor_reached = False
     for it in range(1, options.max_iterations + 1):
         tol = options.rtol * ref + options.atol
-        if norm <= tol:
+        if norm <= tol or (floor_reached and norm <= np.sqrt(options.rtol) * ref + options.atol):
             report.converged = True
             break
         system.jacobian()
@@ -74,6 +77,7 @@ def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions())
         except np.linalg.LinAlgError as err:
             report.reason = str(err)
             break
+        floor_reached = report.increments[-1] <= options.xtol * system.state_norm()
         system.update()
         report.iterations = it
         norm, ref = system.residual(load_factor)

@@ -133,7 +133,8 @@ if comm.rank == 0:
     fig.savefig(os.path.join(out, "cantilever_rollup_2d.png"), dpi=120)
     plt.close(fig)
     with open(os.path.join(out, "tip_values.json"), "w") as f:
-        json.dump({"load_factor": lam.tolist(), "ux": u.tolist(), "uy": w.tolist(), "rz": phi.tolist()}, f)
+        json.dump({"load_factor": lam.tolist(), "ux": u.tolist(), "uy": w.tolist(), "rz": phi.tolist(),
+                   "ranks": comm.size}, f)
 
 # %% [markdown]
 # ## Verification

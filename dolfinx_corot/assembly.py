@@ -106,6 +106,12 @@ class System:
         pc.setFactorSolverType("mumps")
         self.ksp.setFromOptions()
         self.ksp.setOperators(self.A)
+        self._mumps = self.ksp.getType() == "preonly" and pc.getType() == "lu" \
+            and pc.getFactorSolverType() == "mumps"
+        if self._mumps:
+            # null-pivot detection (ICNTL 24): a singular tangent is reported, not solved
+            pc.setFactorSetUpSolverType()
+            pc.getFactorMatrix().setMumpsIcntl(24, 1)
 
     # -- residual -----------------------------------------------------------
     def residual(self, load_factor: float) -> tuple[float, float]:
@@ -145,6 +151,12 @@ class System:
         if reason < 0:
             raise np.linalg.LinAlgError(f"linear solve failed (PETSc reason {reason}); "
                                         "the tangent may be singular (a missing support?)")
+        if self._mumps:
+            null_pivots = self.ksp.getPC().getFactorMatrix().getMumpsInfog(28)
+            if null_pivots > 0:
+                raise np.linalg.LinAlgError(
+                    f"the tangent stiffness is singular ({null_pivots} zero pivot(s)): a missing support "
+                    "(rigid-body motion), a mechanism, or a limit point under load control")
         return self.dx.norm()
 
     def update(self) -> None:

@@ -1,0 +1,28 @@
+# dolfinx_corot — set-up, demo, tests, benchmarks.
+# `make demo` and `make test` do the whole set-up on a fresh Debian 12 first.
+PY := .venv/bin/python
+export OPENBLAS_NUM_THREADS ?= 1
+export OMPI_ALLOW_RUN_AS_ROOT := 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
+
+.PHONY: setup demo demos test bench clean-cache
+
+setup:
+	@bash scripts/setup.sh
+
+demo: setup
+	$(PY) demos/euler_beam_2d.py
+	@echo "results: output/euler_beam_2d/"
+
+demos: setup
+	@for d in demos/*.py; do echo "== $$d"; $(PY) $$d || exit 1; done
+
+test: setup
+	$(PY) -m pytest -ra tests
+
+bench: setup
+	$(PY) benchmarks/beam2d.py
+
+# numba's on-disk cache does not see edits of inlined callees in other modules
+clean-cache:
+	find dolfinx_corot -name '*.nbi' -delete -o -name '*.nbc' -delete

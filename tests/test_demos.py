@@ -1,0 +1,52 @@
+"""Every demo is run (its verification cell asserts against its reference), serially and under MPI."""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DEMOS = sorted(p.stem for p in (ROOT / "demos").glob("*.py"))
+MPI_DEMOS = ["euler_beam_2d", "cantilever_rollup_2d"]
+
+
+def _run(cmd, outdir, timeout=900):
+    env = dict(os.environ, DC_OUTPUT_DIR=str(outdir), CI=os.environ.get("CI", "true"),
+               OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
+               OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    proc = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=timeout)
+    assert proc.returncode == 0, f"{' '.join(map(str, cmd))} failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+    return proc.stdout
+
+
+@pytest.fixture(scope="module")
+def serial_outputs(tmp_path_factory):
+    return tmp_path_factory.mktemp("serial")
+
+
+@pytest.mark.demo
+@pytest.mark.parametrize("demo", DEMOS)
+def test_demo_runs_and_verifies(demo, serial_outputs):
+    out = _run([sys.executable, f"demos/{demo}.py"], serial_outputs)
+    assert f"{demo}: verified" in out
+    files = os.listdir(serial_outputs / demo)
+    assert any(f.endswith(".csv") for f in files) and any(f.endswith(".png") for f in files), files
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("demo", MPI_DEMOS)
+def test_demo_under_mpi_reproduces_serial_values(demo, serial_outputs, tmp_path):
+    ser = serial_outputs / demo / "tip_values.json"
+    if not ser.exists():
+        _run([sys.executable, f"demos/{demo}.py"], serial_outputs)
+    out = _run(["mpirun", "-n", "2", sys.executable, f"demos/{demo}.py"], tmp_path)
+    assert f"{demo}: verified" in out
+    a = json.loads(ser.read_text())
+    b = json.loads((tmp_path / demo / "tip_values.json").read_text())
+    assert b["ranks"] == 2
+    np.testing.assert_array_equal(a["load_factor"], b["load_factor"])
+    for key in ("ux", "uy", "rz"):
+        np.testing.assert_allclose(b[key], a[key], rtol=0, atol=1e-8)

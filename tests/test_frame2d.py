@@ -1,0 +1,185 @@
+"""2D beams and bars assembled through DOLFINx: physics, drivers, rollback, bad input."""
+import numpy as np
+import pytest
+
+import dolfinx_corot as dc
+from dolfinx_corot.assembly import System
+from dolfinx_corot.io.gmsh_models import polyline
+from dolfinx_corot.solvers.newton import NewtonOptions, newton
+
+E, B, H = 1e5, 0.1, 0.1
+EI = E * B * H**3 / 12
+
+
+@pytest.fixture(scope="module")
+def cantilever():
+    return polyline([[0.0, 0.0], [2.0, 0.0]], 8, line_name="beam")
+
+
+def _cantilever_scene(tmesh, large, kinematics="bernoulli", P=1e-3, nu=0.0):
+    sc = dc.Scene(large_rotations=large)
+    beam = sc.add_beam(tmesh, "beam", section=dc.Rectangle(B, H), material=dc.Elastic(E, nu),
+                       kinematics=kinematics)
+    sc.fix(beam, "base")
+    sc.load(beam, "tip", force=(0.0, -P))
+    sc.monitor("tip", beam, "tip")
+    return sc
+
+
+@pytest.mark.parametrize("kinematics", ["bernoulli", "timoshenko"])
+def test_linear_cantilever_is_exact_and_takes_one_iteration(cantilever, kinematics):
+    """Tip deflection PL³/3EI (+ PL/GAs for Timoshenko): exact for two-node elements."""
+    P, L, nu = 1e-3, 2.0, 0.3
+    sc = _cantilever_scene(cantilever, False, kinematics, P, nu)
+    res = dc.solve(sc, dc.LoadControl(steps=1))
+    exact = -P * L**3 / (3 * EI)
+    if kinematics == "timoshenko":
+        exact -= P * L / (E / (2 * (1 + nu)) * 5 / 6 * B * H)
+    assert res.history.rows[-1]["iterations"] == 1
+    assert abs(res.history.column("tip_uy")[-1] - exact) < 1e-10 * abs(exact)
+    assert sc.effects()[0].startswith("beam elements (geometrically linear")
+
+
+def test_small_load_corotational_matches_linear(cantilever):
+    """P → 0: the co-rotational solution tends to the linear one (difference O(P²))."""
+    for P in (1e-4, 1e-5):
+        lin = dc.solve(_cantilever_scene(cantilever, False, P=P), dc.LoadControl(steps=1))
+        cor = dc.solve(_cantilever_scene(cantilever, True, P=P), dc.LoadControl(steps=1))
+        a, b = lin.history.column("tip_uy")[-1], cor.history.column("tip_uy")[-1]
+        assert abs(a - b) < 2.0 * abs(a) * (P * 2.0**2 / EI)  # relative difference ~ rotation²
+
+
+def _two_bar_truss(h=0.5, span=2.0, prestress=0.0):
+    """Symmetric two-bar (von Mises) truss: supports at (±span/2, 0), apex at (0, h)."""
+    tm = polyline([[-span / 2, 0.0], [0.0, h], [span / 2, 0.0]], 1, line_name="bars",
+                  point_names={0: "left", 1: "apex", 2: "right"})
+    sc = dc.Scene()
+    bars = sc.add_truss(tm, "bars", area=1e-2, material=dc.Elastic(E), prestress_force=prestress)
+    sc.fix(bars, "left", dofs=("ux", "uy"))
+    sc.fix(bars, "right", dofs=("ux", "uy"))
+    sc.fix(bars, "apex", dofs=("ux",))
+    sc.monitor("apex", bars, "apex")
+    return sc, bars
+
+
+def test_two_bar_truss_large_displacement_equilibrium():
+    """Vertical apex load P against the exact equilibrium P(w) = 2 N (h + w)/l, N = EA (l − l0)/l0."""
+    h, span, EA = 0.5, 2.0, E * 1e-2
+    sc, bars = _two_bar_truss(h, span)
+    P = 34.0  # below the limit load 38.38 (at w = -0.222) for these data
+    sc.load(bars, "apex", force=(0.0, -P))
+    res = dc.solve(sc, dc.LoadControl(steps=10))
+    w = res.history.column("apex_uy")
+    lam = res.history.column("load_factor")
+    l0 = np.hypot(span / 2, h)
+    l = np.hypot(span / 2, h + w)
+    P_exact = -2 * EA * (l - l0) / l0 * (h + w) / l
+    np.testing.assert_allclose(P_exact, lam * P, rtol=1e-9)
+    assert w[-1] < -0.2 * h  # a large displacement, not a linear one
+    # rotations of bar-only nodes have no stiffness and are fixed automatically
+    assert np.all(res.history.column("apex_rz") == 0.0)
+
+
+def test_prestressed_string_under_transverse_load():
+    """Two prestressed bars in line (a string), transverse load P at the middle node:
+    P = 2 (N0 + EA (l − l0)/l0) w / l with l = √(l0² + w²) — the prestress stiffens the string."""
+    N0, EA = 50.0, E * 1e-2
+    tm = polyline([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]], 1, line_name="string",
+                  point_names={0: "left", 1: "middle", 2: "right"})
+    sc = dc.Scene()
+    s = sc.add_truss(tm, "string", area=1e-2, material=dc.Elastic(E), prestress_force=N0)
+    sc.fix(s, "left", dofs=("ux", "uy"))
+    sc.fix(s, "right", dofs=("ux", "uy"))
+    sc.load(s, "middle", force=(0.0, 20.0))
+    sc.monitor("mid", s, "middle")
+    res = dc.solve(sc, dc.LoadControl(steps=4))
+    w = res.history.column("mid_uy")
+    l = np.hypot(1.0, w)
+    P_exact = 2 * (N0 + EA * (l - 1.0)) * w / l
+    np.testing.assert_allclose(P_exact, 20.0 * res.history.column("load_factor"), rtol=1e-9)
+    assert np.all(res.history.column("mid_ux") == 0.0)
+
+
+def test_failed_step_is_cut_and_the_state_restored_exactly():
+    """A load step beyond reach of Newton is halved; the final state equals the fine-step one."""
+    tm = polyline([[0.0, 0.0], [0.0, 1.0]], 10, line_name="column")
+    Ncr = np.pi**2 * EI / 4
+
+    def scene():
+        sc = dc.Scene()
+        col = sc.add_beam(tm, "column", section=dc.Rectangle(B, H), material=dc.Elastic(E))
+        sc.fix(col, "base")
+        sc.load(col, "tip", force=(0.0, -Ncr), moment=Ncr * 0.01)
+        sc.monitor("tip", col, "tip")
+        return sc
+
+    coarse = dc.solve(scene(), dc.LoadControl(steps=1, final=4.0, newton=NewtonOptions(max_iterations=6)))
+    assert coarse.totals["cuts"] > 0 and coarse.history.column("load_factor")[-1] == 4.0
+    fine = dc.solve(scene(), dc.LoadControl(steps=40, final=4.0))
+    for c in ("tip_ux", "tip_uy", "tip_rz"):
+        assert abs(coarse.history.column(c)[-1] - fine.history.column(c)[-1]) < 1e-9
+
+    # exact rollback: a failing Newton attempt, then restore, gives the state bit for bit
+    sc = scene()
+    system = System(sc.model)
+    newton(system, 1.0)
+    before = sc.model.checkpoint()
+    report = newton(system, 50.0, NewtonOptions(max_iterations=3))
+    assert not report.converged
+    system.restore(before)
+    np.testing.assert_array_equal(sc.model.state.x.array, before)
+    system.destroy()
+
+
+def test_snap_through_under_load_control_raises_with_the_converged_history():
+    """Past the limit load of a shallow truss load control cannot go on: a clear error, history kept."""
+    sc, bars = _two_bar_truss(h=0.1)
+    sc.load(bars, "apex", force=(0.0, -1.0))  # limit load 0.381 for these data
+    with pytest.raises(dc.ConvergenceError) as err:
+        dc.solve(sc, dc.LoadControl(steps=20, final=1.0, max_cuts=3,
+                                    newton=NewtonOptions(max_iterations=10)))
+    msg = str(err.value)
+    assert "no convergence to load factor" in msg and "arc-length" in msg
+    hist = err.value.result.history
+    assert len(hist) >= 1 and not err.value.result.completed
+    assert 0.3 <= hist.column("load_factor")[-1] < 0.3811
+
+
+def test_bad_input_is_named(cantilever):
+    with pytest.raises(dc.GroupNotFoundError, match=r"'tipp' not found.*'tip' \(dim 0\)"):
+        sc = dc.Scene()
+        beam = sc.add_beam(cantilever, "beam", section=dc.Rectangle(B, H), material=dc.Elastic(E))
+        sc.load(beam, "tipp", force=(1.0, 0.0))
+    with pytest.raises(dc.GroupNotFoundError, match="'column' not found"):
+        dc.Scene().add_beam(cantilever, "column", section=dc.Rectangle(B, H), material=dc.Elastic(E))
+    with pytest.raises(ValueError, match="Young's modulus E = -1"):
+        dc.Elastic(-1.0)
+    with pytest.raises(ValueError, match="Poisson's ratio nu = 0.5"):
+        dc.Elastic(1.0, 0.5)
+    with pytest.raises(ValueError, match="Rectangle: b = 0"):
+        dc.Rectangle(0.0, 1.0)
+    sc = dc.Scene()
+    beam = sc.add_beam(cantilever, "beam", section=dc.Rectangle(B, H), material=dc.Elastic(E))
+    with pytest.raises(ValueError, match=r"unknown dof\(s\) \['uz'\]"):
+        sc.fix(beam, "base", dofs=("uz",))
+    with pytest.raises(ValueError, match="already belong to beam 'beam'"):
+        sc.add_truss(cantilever, "beam", area=1.0, material=dc.Elastic(E))
+    with pytest.raises(ValueError, match="shear area As > 0"):
+        dc.Scene().add_beam(cantilever, "beam", section=dc.Section(A=1.0, I=1.0), material=dc.Elastic(E),
+                            kinematics="timoshenko")
+    with pytest.raises(ValueError, match="'dim 1:1'|group of cells"):
+        dc.Scene().add_beam(cantilever, "tip", section=dc.Rectangle(B, H), material=dc.Elastic(E))
+
+
+def test_zero_length_element_is_reported():
+    tm = polyline([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [2.0, 0.0]], 1, line_name="beam")
+    with pytest.raises(ValueError, match=r"zero length, the first at \(1, 0\)"):
+        dc.Scene().add_beam(tm, "beam", section=dc.Rectangle(B, H), material=dc.Elastic(E))
+
+
+def test_missing_support_gives_a_clear_error(cantilever):
+    sc = dc.Scene()
+    beam = sc.add_beam(cantilever, "beam", section=dc.Rectangle(B, H), material=dc.Elastic(E))
+    sc.load(beam, "tip", force=(0.0, -1.0))
+    with pytest.raises(dc.ConvergenceError, match="singular"):
+        dc.solve(sc, dc.LoadControl(steps=1, max_cuts=0))

@@ -58,6 +58,7 @@ class Model(Protocol):
     def dirichlet_bcs(self) -> list: ...                        # DOLFINx DirichletBCs (homogeneous)
     def external_force(self, b: PETSc.Vec) -> None: ...         # fill the reference load vector
     def update(self, dx: PETSc.Vec) -> None: ...                # x ← x ⊕ dx
+    def extrapolate(self, older: object, newer: object, factor: float) -> None: ...
     def checkpoint(self) -> object: ...
     def restore(self, cp: object) -> None: ...
 
@@ -90,6 +91,7 @@ class System:
         self.b = dolfinx.fem.petsc.create_vector(self.L)
         self.fint = self.b.duplicate()
         self.dx = self.b.duplicate()
+        self.step_dx = self.b.duplicate()
         self.fext = self.b.duplicate()
         with self.fext.localForm() as f:
             f.set(0.0)
@@ -159,15 +161,33 @@ class System:
                     "(rigid-body motion), a mechanism, or a limit point under load control")
         return self.dx.norm()
 
-    def update(self) -> None:
-        """x ← x ⊕ dx through the model's update rule (multiplicative for rotations)."""
+    def update(self, scale: float = 1.0) -> None:
+        """x ← x ⊕ scale·dx through the model's update rule (multiplicative for rotations)."""
         t = time.perf_counter()
+        if scale != 1.0:
+            self.dx.scale(scale)
         self.model.update(self.dx)
+        self.step_dx.axpy(scale, self.dx)
+        if scale != 1.0:
+            self.dx.scale(1.0 / scale)
         self.timings.update += time.perf_counter() - t
 
-    def state_norm(self) -> float:
-        """‖x‖ of the configuration (displacements and rotation increments mixed)."""
-        return self.model.state.vector.norm()
+    def directional_residual(self) -> float:
+        """dx·r at the last residual: minus the derivative of the energy along dx."""
+        return self.dx.dot(self.b)
+
+    def begin_step(self) -> None:
+        """Start summing the corrections of a new step (see :meth:`step_increment_norm`)."""
+        with self.step_dx.localForm() as s:
+            s.set(0.0)
+
+    def step_increment_norm(self) -> float:
+        """‖Σ corrections‖ since :meth:`begin_step`."""
+        return self.step_dx.norm()
+
+    def extrapolate(self, older, newer, factor: float) -> None:
+        """Set x to newer ⊕ factor·(newer ⊖ older) (a secant predictor)."""
+        self.model.extrapolate(older, newer, factor)
 
     def checkpoint(self):
         return self.model.checkpoint()
@@ -180,7 +200,7 @@ class System:
         return self.fint
 
     def destroy(self) -> None:
-        for obj in (self.ksp, self.A, self.b, self.fint, self.dx, self.fext):
+        for obj in (self.ksp, self.A, self.b, self.fint, self.dx, self.step_dx, self.fext):
             obj.destroy()
 
 

@@ -148,6 +148,10 @@ class Frame2D:
         self.state.vector.axpy(1.0, dx)
         self.state.x.scatter_forward()
 
+    def extrapolate(self, older: np.ndarray, newer: np.ndarray, factor: float) -> None:
+        """x = newer + factor (newer − older): angles of SO(2) extrapolate linearly."""
+        self.state.x.array[:] = newer + factor * (newer - older)
+
     def checkpoint(self) -> np.ndarray:
         return self.state.x.array.copy()
 

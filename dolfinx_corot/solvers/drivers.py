@@ -26,13 +26,17 @@ logger = logging.getLogger(__name__)
 class LoadControl:
     """Load factors ``load_factors`` (increasing), or ``steps`` equal steps up to ``final``.
 
-    max_cuts: successive halvings of a failing step before giving up.
+    max_cuts: successive halvings of a failing step before giving up;
+    extrapolate: start each step from the secant extrapolation of the last
+    converged increment instead of the last converged state (exact rollback
+    still restores the converged state).
     """
 
     steps: int = 10
     final: float = 1.0
     load_factors: Sequence[float] | None = None
     max_cuts: int = 8
+    extrapolate: bool = False
     newton: NewtonOptions = NewtonOptions()
 
     def targets(self) -> np.ndarray:
@@ -61,6 +65,7 @@ def solve(scene, driver: LoadControl, system: System | None = None, on_step=None
     history = History()
     t_start = time.perf_counter()
     lam = 0.0
+    previous = None
     step = 0
     cuts_total = 0
     iters_total = 0
@@ -72,6 +77,9 @@ def solve(scene, driver: LoadControl, system: System | None = None, on_step=None
                 cp = system.checkpoint()
                 t0 = time.perf_counter()
                 timings0 = system.timings.copy()
+                if driver.extrapolate and previous is not None and lam > previous[0]:
+                    # secant predictor along the last converged increment
+                    system.extrapolate(previous[1], cp, (trial - lam) / (lam - previous[0]))
                 report = newton(system, trial, driver.newton)
                 if not report.converged:
                     system.restore(cp)
@@ -85,6 +93,7 @@ def solve(scene, driver: LoadControl, system: System | None = None, on_step=None
                         raise ConvergenceError(msg, Result(history, False, msg,
                                                            _totals(history, t_start, cuts_total, iters_total)))
                     continue
+                previous = (lam, cp)
                 lam = trial
                 step += 1
                 iters_total += report.iterations

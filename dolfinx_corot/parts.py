@@ -126,7 +126,8 @@ class Frame2D:
         v2c = mesh.topology.connectivity(0, 1)
         vmap = mesh.topology.index_map(0)
         nv = vmap.size_local + vmap.num_ghosts
-        bending = np.array([self._bending[v2c.links(v)].any() for v in range(nv)], dtype=bool)
+        counts = np.add.reduceat(self._bending[v2c.array].astype(np.int32), v2c.offsets[:-1][:nv])
+        bending = counts > 0
         # a vertex may see its bending cell only on another rank: reduce over owners
         flag = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1)))
         vert_to_dof = dolfinx.fem.locate_dofs_topological(flag.function_space, 0, np.arange(nv, dtype=np.int32))

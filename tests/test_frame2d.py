@@ -230,3 +230,24 @@ def test_assembled_tangent_matches_finite_differences_of_assembled_residual():
     sub = np.ix_(free, free)
     assert np.abs(K[sub] - Kfd[sub]).max() < 1e-6 * np.abs(K[sub]).max()
     system.destroy()
+
+
+def test_cells_in_two_groups_are_refused():
+    import gmsh
+    from mpi4py import MPI
+
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    p0, p1 = gmsh.model.geo.addPoint(0, 0, 0), gmsh.model.geo.addPoint(1, 0, 0)
+    line = gmsh.model.geo.addLine(p0, p1)
+    gmsh.model.geo.synchronize()
+    gmsh.model.addPhysicalGroup(1, [line], 1)
+    gmsh.model.setPhysicalName(1, 1, "beam")
+    gmsh.model.addPhysicalGroup(1, [line], 2)
+    gmsh.model.setPhysicalName(1, 2, "everything")
+    gmsh.model.mesh.generate(1)
+    try:
+        with pytest.raises(ValueError, match="two physical groups, 'beam' and 'everything'"):
+            dc.from_gmsh(gmsh.model, gdim=2, comm=MPI.COMM_SELF)
+    finally:
+        gmsh.finalize()

@@ -69,11 +69,18 @@ class TaggedMesh:
             self.mesh.topology.create_connectivity(self.tdim, 0)
             c2v = self.mesh.topology.connectivity(self.tdim, 0)
             cells = self.cells(name)
-            if len(cells) == 0:
-                return np.zeros(0, dtype=np.int32)
-            return np.unique(np.concatenate([c2v.links(c) for c in cells])).astype(np.int32)
+            counts = np.diff(c2v.offsets)[cells]
+            idx = np.repeat(c2v.offsets[cells], counts) + _ramp(counts)
+            return np.unique(c2v.array[idx]).astype(np.int32)
         pts = self.points[name]
         return _locate_vertices(self.mesh, pts)
+
+
+def _ramp(counts: np.ndarray) -> np.ndarray:
+    """0, 1, …, c−1 for each c in counts, concatenated."""
+    total = int(np.sum(counts))
+    starts = np.repeat(np.cumsum(counts) - counts, counts)
+    return np.arange(total) - starts
 
 
 def _locate_vertices(mesh: dolfinx.mesh.Mesh, pts: np.ndarray) -> np.ndarray:
@@ -105,6 +112,18 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0) 
         if not phys:
             error = "the gmsh model has no physical groups: add at least one for the cells"
         tdim = max((d for d, _ in phys), default=0)
+        seen: dict[int, str] = {}
+        for dim, tag in phys:
+            if dim != tdim or error:
+                continue
+            name = model.getPhysicalName(dim, tag) or f"{dim}:{tag}"
+            for entity in model.getEntitiesForPhysicalGroup(dim, tag):
+                for etags in model.mesh.getElements(dim, entity)[1]:
+                    for e in etags[:1]:
+                        if int(e) in seen and seen[int(e)] != name:
+                            error = (f"cells belong to two physical groups, '{seen[int(e)]}' and '{name}': "
+                                     "each cell must be in exactly one group of its dimension")
+                        seen[int(e)] = name
         for dim, tag in phys:
             name = model.getPhysicalName(dim, tag) or f"{dim}:{tag}"
             if name in groups:

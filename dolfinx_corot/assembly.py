@@ -92,6 +92,9 @@ class System:
         self.fint = self.b.duplicate()
         self.dx = self.b.duplicate()
         self.step_dx = self.b.duplicate()
+        self.lift = self.b.duplicate()
+        self._prescribed = bool(getattr(model, "has_prescribed_motion", False))
+        self.load_factor = 0.0
         self.fext = self.b.duplicate()
         with self.fext.localForm() as f:
             f.set(0.0)
@@ -117,12 +120,16 @@ class System:
 
     # -- residual -----------------------------------------------------------
     def residual(self, load_factor: float) -> tuple[float, float]:
-        """Assemble b = λ f_ext − f_int with zero rows on supported dofs.
+        """Assemble b = λ f_ext − f_int; on constrained dofs b = ū(λ) − x (0 on supports).
 
-        Returns (‖b‖, reference force norm) where the reference is the larger
-        of ‖λ f_ext‖ and ‖f_int‖ over all dofs (reactions included).
+        With prescribed displacements the columns of constrained dofs are
+        lifted, b_f −= K_fc (ū − x)_c, so that one Newton correction honours
+        them exactly. Returns (‖b‖, reference force norm) where the
+        reference is the larger of ‖λ f_ext‖ and ‖f_int‖ over all dofs
+        (reactions included).
         """
         t = time.perf_counter()
+        self.load_factor = load_factor
         with self.fint.localForm() as f:
             f.set(0.0)
         dolfinx.fem.petsc.assemble_vector(self.fint, self.L)
@@ -131,7 +138,15 @@ class System:
         self.fext.copy(self.b)
         self.b.scale(load_factor)
         self.b.axpy(-1.0, self.fint)
-        dolfinx.fem.petsc.set_bc(self.b, self.bcs)
+        x = self.model.state.vector
+        if self._prescribed:
+            self.model.set_load_factor(load_factor)
+            with self.lift.localForm() as f:
+                f.set(0.0)
+            dolfinx.fem.petsc.apply_lifting(self.lift, [self.a], bcs=[self.bcs], x0=[x], scale=1.0)
+            self.lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            self.b.axpy(1.0, self.lift)
+        dolfinx.fem.petsc.set_bc(self.b, self.bcs, x, 1.0)
         norm = self.b.norm()
         self.timings.assembly += time.perf_counter() - t
         return norm, ref
@@ -195,12 +210,12 @@ class System:
     def restore(self, cp) -> None:
         self.model.restore(cp)
 
-    def reactions(self) -> PETSc.Vec:
-        """f_int − λ f_ext at the last residual, i.e. the support reactions (ghosted vector)."""
+    def internal_force(self) -> PETSc.Vec:
+        """f_int at the last residual, all dofs: on supported dofs it is the reaction."""
         return self.fint
 
     def destroy(self) -> None:
-        for obj in (self.ksp, self.A, self.b, self.fint, self.dx, self.step_dx, self.fext):
+        for obj in (self.ksp, self.A, self.b, self.fint, self.dx, self.step_dx, self.lift, self.fext):
             obj.destroy()
 
 

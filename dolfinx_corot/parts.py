@@ -56,6 +56,8 @@ class Frame2D:
         self.parts: list[PartRef] = []
         self._bcs: list[tuple[np.ndarray, tuple[int, ...]]] = []
         self._loads: list[tuple[np.ndarray, np.ndarray]] = []
+        self._prescribed: list[tuple[np.ndarray, int, float]] = []
+        self._prescribed_values: list[tuple[dolfinx.fem.Function, np.ndarray, float]] = []
         self._forms = None
 
     # -- building -----------------------------------------------------------
@@ -92,6 +94,10 @@ class Frame2D:
     def fix(self, where: str, dofs: tuple[int, ...]) -> None:
         self._bcs.append((self.tmesh.vertices(where), dofs))
 
+    def prescribe(self, where: str, comp: int, value: float) -> None:
+        """Prescribed displacement ``value``·λ of dof ``comp`` at the nodes of ``where``."""
+        self._prescribed.append((self.tmesh.vertices(where), comp, float(value)))
+
     def add_load(self, where: str, values: np.ndarray) -> None:
         """Nodal load (fx, fy, mz) at every node of group ``where`` (scaled by the load factor)."""
         self._loads.append((self.tmesh.vertices(where), np.asarray(values, dtype=float)))
@@ -111,13 +117,37 @@ class Frame2D:
         return self._forms
 
     def dirichlet_bcs(self) -> list:
+        """Supports (zero) and prescribed displacements (λ-scaled values, see :meth:`set_load_factor`)."""
         zero = PETSc.ScalarType(0.0)
         bcs = []
         for vertices, comps in self._bcs + [(self._rotation_free_vertices(), (2,))]:
             for comp in comps:
                 dofs = dolfinx.fem.locate_dofs_topological(self.V.sub(comp), 0, vertices)
                 bcs.append(dolfinx.fem.dirichletbc(zero, dofs, self.V.sub(comp)))
+        self._prescribed_values = []
+        for vertices, comp, value in self._prescribed:
+            Vi, _ = self.V.sub(comp).collapse()
+            g = dolfinx.fem.Function(Vi)
+            dofs = dolfinx.fem.locate_dofs_topological((self.V.sub(comp), Vi), 0, vertices)
+            bcs.append(dolfinx.fem.dirichletbc(g, dofs, self.V.sub(comp)))
+            self._prescribed_values.append((g, dofs[1], value))
         return bcs
+
+    @property
+    def has_prescribed_motion(self) -> bool:
+        return any(value != 0.0 for _, _, value in self._prescribed)
+
+    def set_load_factor(self, load_factor: float) -> None:
+        """Set the prescribed displacements to λ times their values."""
+        for g, dofs, value in self._prescribed_values:
+            g.x.array[dofs] = load_factor * value
+
+    def reaction(self, where: str, fint: PETSc.Vec) -> np.ndarray:
+        """Sum over the nodes of ``where`` of the assembled internal force (fx, fy, mz) (all ranks)."""
+        blocks = assembly.owned_dofs_of_vertices(self.V, self.tmesh.vertices(where))
+        with fint.localForm() as f:
+            local = f.array.reshape(-1, 3)[blocks].sum(axis=0) if len(blocks) else np.zeros(3)
+        return assembly.global_sum(self.V.mesh.comm, np.asarray(local, dtype=float))
 
     def _rotation_free_vertices(self) -> np.ndarray:
         """Vertices touched by no bending element: their rotation has no stiffness and is fixed."""

@@ -34,6 +34,7 @@ class Monitor:
     name: str
     part: PartRef
     where: str
+    kind: str = "dofs"  # or "reaction"
 
 
 class Scene:
@@ -48,6 +49,7 @@ class Scene:
         self._models: dict[int, Frame2D] = {}
         self.monitors: list[Monitor] = []
         self._loads = 0
+        self._prescribed = 0
 
     # -- parts -----------------------------------------------------------------
     def _model(self, tmesh: TaggedMesh) -> Frame2D:
@@ -103,6 +105,23 @@ class Scene:
             raise ValueError(f"fix '{where}': unknown dof(s) {bad}; this part has {names}")
         model.fix(where, tuple(names.index(d) for d in dofs))
 
+    def prescribe(self, part: PartRef, where: str, **values: float) -> None:
+        """Prescribed displacement/rotation at the nodes of ``where``, scaled by the load factor.
+
+        Example: ``scene.prescribe(beam, "tip", uy=-1.0)`` (displacement control:
+        λ = 1 moves the tip by −1; read the force with :meth:`monitor_reaction`).
+        """
+        model = part.model
+        names = model.dof_names
+        bad = [d for d in values if d not in names]
+        if bad or not values:
+            raise ValueError(f"prescribe '{where}': give one or more of {names} as keywords; got {list(values)}")
+        for dof, value in values.items():
+            if not np.isfinite(value):
+                raise ValueError(f"prescribe '{where}': {dof} = {value} is not finite")
+            model.prescribe(where, names.index(dof), float(value))
+        self._prescribed += 1
+
     def load(self, part: PartRef, where: str, force=(0.0, 0.0), moment: float = 0.0) -> None:
         """Dead point force (fx, fy) and moment mz at each node of ``where``, scaled by the load factor."""
         force = np.asarray(force, dtype=float)
@@ -116,6 +135,12 @@ class Scene:
         """Record the dofs of the single node of group ``where`` after every step."""
         part.model.nodal_values(where)  # fails early for a missing group
         self.monitors.append(Monitor(name, part, where))
+
+    def monitor_reaction(self, name: str, part: PartRef, where: str) -> None:
+        """Record the force (sum over the nodes of ``where``) that the supports or prescribed
+        displacements there exert on the structure, after every step: name_Fx, name_Fy, name_Mz."""
+        part.model.tmesh.vertices(where)  # fails early for a missing group
+        self.monitors.append(Monitor(name, part, where, "reaction"))
 
     # -- introspection -----------------------------------------------------------
     @property
@@ -133,12 +158,22 @@ class Scene:
             out.append(f"{' and '.join(kinds)} elements ({frame}, 2D)")
         if self._loads:
             out.append("point loads (dead)")
+        if self._prescribed:
+            out.append("prescribed displacements")
         return out
 
-    def monitor_values(self) -> dict[str, float]:
+    def monitor_values(self, system) -> dict[str, float]:
+        """Monitored dofs and reactions at the current state (``system`` holds f_int)."""
         values = {}
         for mon in self.monitors:
-            v = mon.part.model.nodal_values(mon.where)
-            for comp, val in zip(mon.part.model.dof_names, v):
-                values[f"{mon.name}_{comp}"] = float(val)
+            model = mon.part.model
+            if mon.kind == "reaction":
+                # reaction on the structure = λ f_ext − f_int at the constrained nodes
+                fint = model.reaction(mon.where, system.internal_force())
+                fext = model.reaction(mon.where, system.fext) * system.load_factor
+                for comp, val in zip(("Fx", "Fy", "Mz"), fext - fint):
+                    values[f"{mon.name}_{comp}"] = -float(val)
+            else:
+                for comp, val in zip(model.dof_names, model.nodal_values(mon.where)):
+                    values[f"{mon.name}_{comp}"] = float(val)
         return values

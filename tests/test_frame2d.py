@@ -251,3 +251,31 @@ def test_cells_in_two_groups_are_refused():
             dc.from_gmsh(gmsh.model, gdim=2, comm=MPI.COMM_SELF)
     finally:
         gmsh.finalize()
+
+
+def test_displacement_control_reads_the_force_of_load_control(cantilever):
+    """Prescribing the tip deflection that a force P produced gives back P as the reaction
+    (large rotations); in a linear analysis the reaction is 3EIδ/L³ exactly."""
+    P = 3 * EI / 4.0  # tip rotation ≈ 0.9 rad on L = 2
+    load = dc.solve(_cantilever_scene(cantilever, True, P=P), dc.LoadControl(steps=8))
+    uy = load.history.column("tip_uy")[-1]
+    for large in (True, False):
+        sc = dc.Scene(large_rotations=large)
+        beam = sc.add_beam(cantilever, "beam", section=dc.Rectangle(B, H), material=dc.Elastic(E))
+        sc.fix(beam, "base")
+        sc.prescribe(beam, "tip", uy=uy)
+        sc.monitor("tip", beam, "tip")
+        sc.monitor_reaction("actuator", beam, "tip")
+        sc.monitor_reaction("clamp", beam, "base")
+        res = dc.solve(sc, dc.LoadControl(steps=8))
+        row = res.history.rows[-1]
+        assert abs(row["tip_uy"] - uy) < 1e-14
+        assert max(res.history.column("iterations")) <= 6 if large else max(res.history.column("iterations")) == 1
+        expected = -P if large else 3 * EI * uy / 2.0**3
+        assert abs(row["actuator_Fy"] - expected) < 1e-8 * abs(expected), (row["actuator_Fy"], expected)
+        # the clamp balances the actuator
+        assert abs(row["clamp_Fy"] + row["actuator_Fy"]) < 1e-8 * abs(expected)
+        assert abs(row["clamp_Fx"] + row["actuator_Fx"]) < 1e-8 * abs(expected)
+        if large:
+            np.testing.assert_allclose(row["tip_ux"], load.history.column("tip_ux")[-1], atol=1e-9)
+            assert sc.effects()[-1] == "prescribed displacements"

@@ -104,7 +104,7 @@ def solve(scene, driver: LoadControl, system: System | None = None, on_step=None
                        "time_solve": system.timings.solve - timings0.solve,
                        "time_update": system.timings.update - timings0.update,
                        "residuals": " ".join(f"{r:.2e}" for r in report.residuals)}
-                row.update(scene.monitor_values())
+                row.update(scene.monitor_values(system))
                 history.append(row)
                 logger.info("step %d: lambda = %.6g, %d iterations, |r|: %s", step, lam, report.iterations,
                             row["residuals"])

@@ -10,10 +10,10 @@ from .materials import Elastic
 from .result import History, Result
 from .scene import Scene
 from .sections import Circle, Rectangle, Section
-from .solvers import ConvergenceError, LoadControl, NewtonOptions, solve
+from .solvers import ArcLength, ConvergenceError, LoadControl, NewtonOptions, solve
 
 __version__ = "0.1.0"
 
-__all__ = ["Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
+__all__ = ["ArcLength", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
            "NewtonOptions", "Rectangle", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
            "rotations", "solve"]

@@ -78,11 +78,14 @@ class Timings:
 class System:
     """Nonlinear system r(x, λ) = λ f_ext − f_int(x) = 0 of one model.
 
-    The linear solver is MUMPS LU by default; PETSc options with the prefix
-    ``dc_newton_`` override it (e.g. ``-dc_newton_ksp_type gmres``).
+    The linear solver is MUMPS: LDLᵀ (``symmetric=True``, the tangent of
+    conservative elastic structures) whose count of negative pivots is the
+    number of negative eigenvalues of K (Sylvester's law; used to pass limit
+    points), or LU. PETSc options with the prefix ``dc_newton_`` override it
+    (e.g. ``-dc_newton_pc_type lu``).
     """
 
-    def __init__(self, model: Model, options_prefix: str = "dc_newton_"):
+    def __init__(self, model: Model, options_prefix: str = "dc_newton_", symmetric: bool = True):
         self.model = model
         self.comm = model.V.mesh.comm
         self.L, self.a = model.forms()
@@ -107,12 +110,13 @@ class System:
         self.ksp.setOptionsPrefix(options_prefix)
         self.ksp.setType("preonly")
         pc = self.ksp.getPC()
-        pc.setType("lu")
+        pc.setType("cholesky" if symmetric else "lu")
         pc.setFactorSolverType("mumps")
         self.ksp.setFromOptions()
         self.ksp.setOperators(self.A)
-        self._mumps = self.ksp.getType() == "preonly" and pc.getType() == "lu" \
+        self._mumps = self.ksp.getType() == "preonly" and pc.getType() in ("lu", "cholesky") \
             and pc.getFactorSolverType() == "mumps"
+        self._ldlt = self._mumps and pc.getType() == "cholesky"
         if self._mumps:
             # null-pivot detection (ICNTL 24): a singular tangent is reported, not solved
             pc.setFactorSetUpSolverType()
@@ -159,10 +163,12 @@ class System:
         self.A.assemble()
         self.timings.assembly += time.perf_counter() - t
 
-    def solve(self) -> float:
-        """Solve K dx = b; return ‖dx‖."""
+    def solve(self, rhs: PETSc.Vec | None = None, out: PETSc.Vec | None = None) -> float:
+        """Solve K out = rhs (default K dx = b) with the last tangent; return ‖out‖."""
+        rhs = self.b if rhs is None else rhs
+        out = self.dx if out is None else out
         t = time.perf_counter()
-        self.ksp.solve(self.b, self.dx)
+        self.ksp.solve(rhs, out)
         reason = self.ksp.getConvergedReason()
         self.timings.solve += time.perf_counter() - t
         if reason < 0:
@@ -174,7 +180,22 @@ class System:
                 raise np.linalg.LinAlgError(
                     f"the tangent stiffness is singular ({null_pivots} zero pivot(s)): a missing support "
                     "(rigid-body motion), a mechanism, or a limit point under load control")
-        return self.dx.norm()
+        return out.norm()
+
+    def negative_eigenvalues(self) -> int | None:
+        """Number of negative eigenvalues of the last factorized tangent (LDLᵀ only; else None)."""
+        if not self._ldlt:
+            return None
+        return int(self.ksp.getPC().getFactorMatrix().getMumpsInfog(12))
+
+    def reference_load(self, out: PETSc.Vec) -> None:
+        """out = f_ext with zero rows on constrained dofs (right-hand side of K dx_t = f_ext)."""
+        self.fext.copy(out)
+        dolfinx.fem.petsc.set_bc(out, self.bcs, None, 0.0)
+
+    def new_vector(self) -> PETSc.Vec:
+        """A vector laid out like the solution (ghosted)."""
+        return self.b.duplicate()
 
     def update(self, scale: float = 1.0) -> None:
         """x ← x ⊕ scale·dx through the model's update rule (multiplicative for rotations)."""

@@ -72,6 +72,13 @@ class NewtonReport:
         return math.log(c / b) / math.log(b / a)
 
 
+def converged(norm: float, ref: float, report: NewtonReport, system, options: NewtonOptions) -> bool:
+    """Residual test, or a last correction below xtol of the step's summed corrections."""
+    if norm <= options.rtol * ref + options.atol:
+        return True
+    return bool(report.increments) and report.increments[-1] <= options.xtol * system.step_increment_norm()
+
+
 def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions()) -> NewtonReport:
     """Iterate to equilibrium at ``load_factor``; returns a report (does not raise on divergence)."""
     report = NewtonReport(False, 0)

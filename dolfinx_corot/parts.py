@@ -189,6 +189,36 @@ class Frame2D:
     def restore(self, cp: np.ndarray) -> None:
         self.state.x.array[:] = cp
 
+    # -- restart: node-ordered global arrays ------------------------------------
+    def _input_ids(self) -> np.ndarray:
+        """Input (gmsh) node number of every local block of V (owned and ghost)."""
+        mesh = self.V.mesh
+        ids = np.empty(self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts, dtype=np.int64)
+        geo = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)
+        ids[self.V.dofmap.list.array] = geo[mesh.geometry.dofmap.array]
+        return ids
+
+    def to_global(self, local: np.ndarray) -> np.ndarray | None:
+        """Gather a local (blocks, 3) array to rank 0, ordered by input node number (None elsewhere)."""
+        n_owned = self.V.dofmap.index_map.size_local
+        comm = self.V.mesh.comm
+        ids = comm.gather(self._input_ids()[:n_owned], root=0)
+        vals = comm.gather(np.asarray(local).reshape(-1, 3)[:n_owned], root=0)
+        if comm.rank != 0:
+            return None
+        out = np.empty((sum(len(i) for i in ids), 3))
+        for i, v in zip(ids, vals):
+            out[i] = v
+        return out
+
+    def from_global(self, values: np.ndarray) -> np.ndarray:
+        """Local (blocks·3,) array (owned and ghost) from a node-ordered global (n, 3) array."""
+        ids = self._input_ids()
+        if values.shape != (self.V.dofmap.index_map.size_global, 3):
+            raise ValueError(f"the checkpoint holds {values.shape[0]} nodes; this model has "
+                             f"{self.V.dofmap.index_map.size_global}: it was written for another mesh")
+        return values[ids].ravel()
+
     # -- read-out -------------------------------------------------------------
     def nodes(self) -> tuple[np.ndarray, np.ndarray]:
         """(X (n, 2) initial positions, state (n, 3) = ux, uy, rz) of all nodes, on every rank."""

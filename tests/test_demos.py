@@ -50,3 +50,18 @@ def test_demo_under_mpi_reproduces_serial_values(demo, serial_outputs, tmp_path)
     np.testing.assert_allclose(b["load_factor"], a["load_factor"], rtol=1e-8, atol=1e-8)
     for key in ("ux", "uy", "rz"):
         np.testing.assert_allclose(b[key], a[key], rtol=0, atol=1e-8)
+
+
+@pytest.mark.mpi
+def test_restart_under_mpi_matches_serial(tmp_path):
+    """Checkpoint and restart of an arc-length run on 2 ranks: exact continuation, serial numbers."""
+    runs = {}
+    for n in (1, 2):
+        cmd = ([sys.executable] if n == 1 else ["mpirun", "-n", "2", sys.executable])
+        out = _run(cmd + ["tests/mpi/restart_arclength.py", str(tmp_path / f"r{n}.npz")], tmp_path)
+        runs[n] = json.loads(out.strip().splitlines()[-1])
+    assert runs[2]["ranks"] == 2
+    for r in runs.values():
+        assert r["diff"] < 1e-12
+    assert abs(runs[1]["load_factor"] - runs[2]["load_factor"]) < 1e-8
+    np.testing.assert_allclose(runs[2]["tip"], runs[1]["tip"], atol=1e-8)

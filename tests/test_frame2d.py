@@ -279,3 +279,38 @@ def test_displacement_control_reads_the_force_of_load_control(cantilever):
         if large:
             np.testing.assert_allclose(row["tip_ux"], load.history.column("tip_ux")[-1], atol=1e-9)
             assert sc.effects()[-1] == "prescribed displacements"
+
+
+@pytest.mark.parametrize("driver_kind", ["load", "arc"])
+def test_restart_reproduces_an_uninterrupted_run(tmp_path, driver_kind):
+    """Stop half-way with a checkpoint, restart, and land on the uninterrupted run to 1e-12."""
+    tm = polyline([[0.0, 0.0], [0.0, 120.0], [24.0, 120.0], [120.0, 120.0]], [10, 2, 8], line_name="frame",
+                  point_names={0: "A", 2: "load", 3: "B"})
+
+    def scene(large=True):
+        sc = dc.Scene(large_rotations=large)
+        f = sc.add_beam(tm, "frame", section=dc.Section(A=6.0, I=2.0), material=dc.Elastic(720.0))
+        sc.fix(f, "A", dofs=("ux", "uy"))
+        sc.fix(f, "B", dofs=("ux", "uy"))
+        sc.load(f, "load", force=(0.0, -0.1))
+        sc.monitor("P", f, "load")
+        return sc
+
+    def driver(n):
+        if driver_kind == "load":
+            return dc.LoadControl(steps=n, final=n * 0.5)
+        return dc.ArcLength(initial_increment=0.5, desired_iterations=4, max_steps=n)
+
+    full_scene = scene()
+    full = dc.solve(full_scene, driver(30))
+    path = str(tmp_path / "restart.npz")
+    dc.solve(scene(), driver(15), checkpoint=path)
+    resumed_scene = scene()
+    resumed = dc.solve(resumed_scene, driver(30), restart=path)
+    assert len(resumed.history) == 30 and resumed.history.rows[14]["step"] == 15
+    np.testing.assert_allclose(resumed_scene.model.state.x.array, full_scene.model.state.x.array,
+                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(resumed.history.column("load_factor"), full.history.column("load_factor"),
+                               rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match="switching large rotations on or off at a restart is not allowed"):
+        dc.solve(scene(large=False), driver(30), restart=path)

@@ -13,8 +13,10 @@ After all cuts a :class:`ConvergenceError` carries every converged step.
 """
 from __future__ import annotations
 
+import json
 import logging
 import math
+import os
 import time
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
@@ -29,12 +31,13 @@ logger = logging.getLogger(__name__)
 
 
 class _Run:
-    """Bookkeeping shared by the drivers: history rows, totals, failure."""
+    """Bookkeeping shared by the drivers: history rows, totals, failure, checkpoints."""
 
-    def __init__(self, scene, system: System, on_step):
+    def __init__(self, scene, system: System, on_step, checkpoint: str | None = None):
         self.scene = scene
         self.system = system
         self.on_step = on_step
+        self.checkpoint_path = checkpoint
         self.history = History()
         self.t_start = time.perf_counter()
         self.cuts = 0
@@ -64,6 +67,48 @@ class _Run:
         if self.on_step is not None:
             self.on_step(row)
         return row
+
+    def save(self, driver_state: dict, vectors: dict | None = None) -> None:
+        """Write the checkpoint (if asked for): configuration, history, driver state.
+
+        vectors: name → ghosted PETSc vector laid out like the solution.
+        The file is replaced atomically, so a crash never leaves it half written.
+        """
+        if self.checkpoint_path is None:
+            return
+        model = self.system.model
+        arrays = {"state": model.to_global(model.state.x.array)}
+        for name, vec in (vectors or {}).items():
+            with vec.localForm() as v:
+                arrays[name] = model.to_global(v.array)
+        if model.V.mesh.comm.rank == 0:
+            meta = {"large_rotations": self.scene.large_rotations, "step": self.step,
+                    "load_factor": self.load_factor, "cuts": self.cuts, "iterations": self.iterations,
+                    "history": self.history.rows, "driver": driver_state}
+            os.makedirs(os.path.dirname(os.path.abspath(self.checkpoint_path)), exist_ok=True)
+            tmp = self.checkpoint_path + ".tmp.npz"
+            np.savez(tmp, meta=np.array(json.dumps(meta)), **arrays)
+            os.replace(tmp, self.checkpoint_path)
+
+    def load(self, path: str, driver_name: str) -> tuple[dict, dict]:
+        """Restore configuration, history and counters from a checkpoint; returns (driver state, arrays)."""
+        with np.load(path) as data:
+            meta = json.loads(str(data["meta"]))
+            arrays = {k: data[k] for k in data.files if k != "meta"}
+        if bool(meta["large_rotations"]) != self.scene.large_rotations:
+            raise ValueError(
+                f"the checkpoint {path} was computed with large_rotations={meta['large_rotations']}; switching "
+                "large rotations on or off at a restart is not allowed (seed §2.2): restart with the same scene")
+        if meta["driver"].get("name") != driver_name:
+            raise ValueError(f"the checkpoint {path} was written by {meta['driver'].get('name')}, "
+                             f"not {driver_name}")
+        model = self.system.model
+        model.state.x.array[:] = model.from_global(arrays.pop("state"))
+        self.step, self.load_factor = meta["step"], meta["load_factor"]
+        self.cuts, self.iterations = meta["cuts"], meta["iterations"]
+        for row in meta["history"]:
+            self.history.append(row)
+        return meta["driver"], arrays
 
     def totals(self) -> dict:
         return {"steps": len(self.history), "newton_iterations": self.iterations, "cuts": self.cuts,
@@ -104,8 +149,10 @@ class LoadControl:
             raise ValueError("LoadControl: load factors must be finite and not empty")
         return lf
 
-    def run(self, run: _Run) -> Result:
+    def run(self, run: _Run, restart: str | None = None) -> Result:
         system = run.system
+        if restart is not None:
+            run.load(restart, "LoadControl")
         lam = run.load_factor
         previous = None
         for target in self.targets():
@@ -131,6 +178,7 @@ class LoadControl:
                 previous = (lam, cp)
                 lam = trial
                 run.record(lam, report, cuts, started)
+                run.save({"name": "LoadControl"})
                 cuts = max(cuts - 1, 0)
         return run.result()
 
@@ -169,7 +217,7 @@ class ArcLength:
     max_cuts: int = 8
     newton: NewtonOptions = field(default_factory=NewtonOptions)
 
-    def run(self, run: _Run) -> Result:
+    def run(self, run: _Run, restart: str | None = None) -> Result:
         system = run.system
         if getattr(system.model, "has_prescribed_motion", False):
             raise NotImplementedError("arc-length with prescribed displacements is not supported; "
@@ -188,6 +236,13 @@ class ArcLength:
         arc = None
         arc_min = arc_max = None
         cuts = 0
+        if restart is not None:
+            state, arrays = run.load(restart, "ArcLength")
+            arc, arc_min, arc_max = state["arc"], state["arc_min"], state["arc_max"]
+            dlam_prev, have_prev = state["dlam_prev"], state["have_prev"]
+            lam = run.load_factor
+            with Dx_prev.localForm() as v:
+                v.array[:] = system.model.from_global(arrays["Dx_prev"])
         while run.step < self.max_steps:
             cp = system.checkpoint()
             started = run.begin()
@@ -279,6 +334,8 @@ class ArcLength:
             cuts = 0
             factor = math.sqrt(self.desired_iterations / max(report.iterations, 1))
             arc = min(max(arc * min(max(factor, 0.5), self.max_growth), arc_min), arc_max)
+            run.save({"name": "ArcLength", "arc": arc, "arc_min": arc_min, "arc_max": arc_max,
+                      "dlam_prev": dlam_prev, "have_prev": have_prev}, {"Dx_prev": Dx_prev})
             if abs(lam) >= self.max_load_factor or (self.stop is not None and self.stop(row)):
                 break
         for v in (f, dxt, dxr, Dx, Dx_prev):
@@ -286,19 +343,25 @@ class ArcLength:
         return run.result()
 
 
-def solve(scene, driver, system: System | None = None, on_step=None) -> Result:
+def solve(scene, driver, system: System | None = None, on_step=None, checkpoint: str | None = None,
+          restart: str | None = None) -> Result:
     """Run ``driver`` (LoadControl or ArcLength) on ``scene``; returns a :class:`Result`.
 
     On a step that fails after all cuts, raises :class:`ConvergenceError`
     whose ``result`` holds every converged step, and the configuration is
     left at the last converged state. ``on_step(row)`` is called after every
     converged step with its history row (e.g. to store snapshots).
+
+    checkpoint: file (``.npz``) rewritten after every converged step with the
+    configuration, the history and the driver's state; restart: such a file
+    to continue from (same scene and driver; the continued run reproduces an
+    uninterrupted one). Switching ``large_rotations`` at a restart is refused.
     """
     own_system = system is None
     if own_system:
         system = System(scene.model)
     try:
-        return driver.run(_Run(scene, system, on_step))
+        return driver.run(_Run(scene, system, on_step, checkpoint), restart)
     finally:
         if own_system:
             system.destroy()

@@ -85,7 +85,7 @@ class System:
     (e.g. ``-dc_newton_pc_type lu``).
     """
 
-    def __init__(self, model: Model, options_prefix: str = "dc_newton_", symmetric: bool = True):
+    def __init__(self, model: Model, options_prefix: str = "dc_newton_", symmetric: bool | None = None):
         self.model = model
         self.comm = model.V.mesh.comm
         self.L, self.a = model.forms()
@@ -106,6 +106,8 @@ class System:
         self._fext_norm = self.fext.norm()
         self.timings = Timings()
 
+        if symmetric is None:
+            symmetric = getattr(model, "symmetric_tangent", True)
         self.ksp = PETSc.KSP().create(self.comm)
         self.ksp.setOptionsPrefix(options_prefix)
         self.ksp.setType("preonly")
@@ -142,7 +144,7 @@ class System:
         self.fext.copy(self.b)
         self.b.scale(load_factor)
         self.b.axpy(-1.0, self.fint)
-        x = self.model.state.vector
+        x = self.model.displacement_vector()
         if self._prescribed:
             self.model.set_load_factor(load_factor)
             with self.lift.localForm() as f:

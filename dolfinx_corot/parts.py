@@ -1,15 +1,21 @@
 """Structural models on DOLFINx meshes.
 
-:class:`Frame2D` holds the beams and bars that live on one 1D mesh in the
-plane: one space with (u_x, u_y, θ_z) per node, the configuration as a
-DOLFINx Function (displacements and *total* nodal angles), per-cell section
-properties as a DG0 Function, and the element kernels of
-:mod:`dolfinx_corot.kernels.line2d` wrapped as DOLFINx forms.
+A model holds the beams and bars that live on one 1D mesh: the space of the
+Newton corrections (one block of dofs per node), the configuration as a
+DOLFINx Function, per-cell section properties as a DG0 Function, and the
+element kernels wrapped as DOLFINx forms.
+
+* :class:`Frame2D` (gdim 2): dofs (u_x, u_y, θ_z); the state holds the
+  displacements and the *total* nodal angles (SO(2) updates are additions).
+* :class:`Frame3D` (gdim 3): dofs (u_x, u_y, u_z, w_x, w_y, w_z), w spatial
+  spins; the state holds the displacements and a unit quaternion per node,
+  updated multiplicatively, q ← exp(w)∘q.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from petsc4py import PETSc
 
@@ -17,37 +23,44 @@ import dolfinx.fem
 import dolfinx.fem.petsc
 import dolfinx.la
 
-from . import assembly
-from .elements import line2d as law
+from . import assembly, rotations
+from .elements import beam3d as law3d
+from .elements import line2d as law2d
 from .io.mesh import TaggedMesh
-from .kernels import line2d as kernels
+from .kernels import beam3d as kernels3d
+from .kernels import line2d as kernels2d
 
 
 @dataclass(frozen=True)
 class PartRef:
     """Handle to a group of elements added to a model (returned by Scene.add_*)."""
 
-    model: "Frame2D"
+    model: "LineFrame"
     name: str
     kind: str
 
 
-class Frame2D:
-    """Beams and bars on one 1D mesh with gdim = 2; dofs (ux, uy, rz) per node."""
+class LineFrame:
+    """What 2D and 3D frames share: cells, properties, supports, loads, forms, read-out."""
 
-    dof_names = ("ux", "uy", "rz")
+    gdim: int
+    dof_names: tuple[str, ...]
+    translations: int           # number of translational dofs per node
+    state_size: int             # entries of the nodal state
+    nprops: int
+    kernels = None
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
         mesh = tmesh.mesh
-        if mesh.topology.dim != 1 or mesh.geometry.dim != 2:
-            raise ValueError(f"a 2D frame needs a mesh of lines in the plane (tdim 1, gdim 2); got "
+        if mesh.topology.dim != 1 or mesh.geometry.dim != self.gdim:
+            raise ValueError(f"a {self.gdim}D frame needs a mesh of lines (tdim 1, gdim {self.gdim}); got "
                              f"tdim {mesh.topology.dim}, gdim {mesh.geometry.dim}: read the gmsh model "
-                             "with from_gmsh(model, gdim=2)")
+                             f"with from_gmsh(model, gdim={self.gdim})")
         self.tmesh = tmesh
         self.large_rotations = bool(large_rotations)
-        self.V = dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=3)
-        self.state = dolfinx.fem.Function(self.V, name="state")
-        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=law.NPROPS)
+        self.ndof = len(self.dof_names)
+        self.V = dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=self.ndof)
+        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=self.nprops)
         self.props = dolfinx.fem.Function(Q, name="section")
         self._prop_blocks = Q.dofmap.list.array  # DG0: one block per cell
         cmap = mesh.topology.index_map(1)
@@ -61,48 +74,57 @@ class Frame2D:
         self._forms = None
 
     # -- building -----------------------------------------------------------
-    def add_elements(self, where: str | None, EA: float, EI: float, GAs: float, N0: float, kind: str) -> PartRef:
+    def add_elements(self, where: str | None, props: np.ndarray, bending: bool, kind: str) -> PartRef:
         label = f"{kind} '{where or 'all cells'}'"
-        law.check_props(EA, EI, GAs, label)
         cells = self.tmesh.cells(where)
         taken = self._owner_of_cell[cells]
         clash = taken[taken != ""]
         if len(clash):
             raise ValueError(f"{label}: its cells already belong to {clash[0]}")
-        self._check_lengths(cells, label)
+        self._check_geometry(cells, label, props)
         self._owner_of_cell[cells] = label
-        self._bending[cells] = EI > 0.0
-        values = self.props.x.array.reshape(-1, law.NPROPS)
-        values[self._prop_blocks[cells]] = (EA, EI, GAs, N0)
+        self._bending[cells] = bending
+        values = self.props.x.array.reshape(-1, self.nprops)
+        values[self._prop_blocks[cells]] = props
         self.props.x.scatter_forward()
         ref = PartRef(self, where or "", kind)
         self.parts.append(ref)
         self._forms = None
         return ref
 
-    def _check_lengths(self, cells: np.ndarray, label: str) -> None:
+    def _element_vectors(self, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         x = self.tmesh.mesh.geometry.x
         gdofs = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 2)[cells]
-        lengths = np.linalg.norm(x[gdofs[:, 1]] - x[gdofs[:, 0]], axis=1)
-        scale = max(float(np.ptp(x, axis=0).max()), 1e-300)
+        return x[gdofs[:, 0]], x[gdofs[:, 1]] - x[gdofs[:, 0]]
+
+    def _check_geometry(self, cells: np.ndarray, label: str, props: np.ndarray) -> None:
+        start, d = self._element_vectors(cells)
+        lengths = np.linalg.norm(d, axis=1)
+        x = self.tmesh.mesh.geometry.x
+        scale = max(float(np.ptp(x, axis=0).max()) if len(x) else 1.0, 1e-300)
         bad = np.flatnonzero(lengths <= 1e-10 * scale)
         if len(bad):
-            p = x[gdofs[bad[0], 0]]
+            p = start[bad[0], : self.gdim]
             raise ValueError(f"{label}: {len(bad)} element(s) of zero length, the first at "
-                             f"({p[0]:.6g}, {p[1]:.6g})")
+                             f"({', '.join(f'{c:.6g}' for c in p)})")
 
     def fix(self, where: str, dofs: tuple[int, ...]) -> None:
         self._bcs.append((self.tmesh.vertices(where), dofs))
 
     def prescribe(self, where: str, comp: int, value: float) -> None:
         """Prescribed displacement ``value``·λ of dof ``comp`` at the nodes of ``where``."""
+        if comp >= self.translations and self.gdim == 3 and value != 0.0:
+            raise NotImplementedError(f"prescribe '{where}': non-zero rotations ({self.dof_names[comp]}) "
+                                      "cannot be prescribed in 3D; prescribe displacements or apply a moment")
         self._prescribed.append((self.tmesh.vertices(where), comp, float(value)))
 
     def add_load(self, where: str, values: np.ndarray) -> None:
-        """Nodal load (fx, fy, mz) at every node of group ``where`` (scaled by the load factor)."""
+        """Nodal load (forces, moments) at every node of group ``where`` (scaled by the load factor)."""
         self._loads.append((self.tmesh.vertices(where), np.asarray(values, dtype=float)))
 
     # -- Model protocol (assembly.System) ------------------------------------
+    symmetric_tangent = True
+
     def forms(self):
         if self._forms is None:
             cmap = self.tmesh.mesh.topology.index_map(1)
@@ -111,8 +133,8 @@ class Frame2D:
             cells = None if all_owned else owned
             self._flag = dolfinx.fem.Constant(self.V.mesh, PETSc.ScalarType(1.0 if self.large_rotations else 0.0))
             coeffs = [self.state, self.props]
-            L = assembly.kernel_form(self.V, kernels.vector_kernel.address, 1, coeffs, [self._flag], cells)
-            a = assembly.kernel_form(self.V, kernels.matrix_kernel.address, 2, coeffs, [self._flag], cells)
+            L = assembly.kernel_form(self.V, self.kernels.vector_kernel.address, 1, coeffs, [self._flag], cells)
+            a = assembly.kernel_form(self.V, self.kernels.matrix_kernel.address, 2, coeffs, [self._flag], cells)
             self._forms = (L, a)
         return self._forms
 
@@ -120,7 +142,8 @@ class Frame2D:
         """Supports (zero) and prescribed displacements (λ-scaled values, see :meth:`set_load_factor`)."""
         zero = PETSc.ScalarType(0.0)
         bcs = []
-        for vertices, comps in self._bcs + [(self._rotation_free_vertices(), (2,))]:
+        rotations_free = tuple(range(self.translations, self.ndof))
+        for vertices, comps in self._bcs + [(self._rotation_free_vertices(), rotations_free)]:
             for comp in comps:
                 dofs = dolfinx.fem.locate_dofs_topological(self.V.sub(comp), 0, vertices)
                 bcs.append(dolfinx.fem.dirichletbc(zero, dofs, self.V.sub(comp)))
@@ -142,13 +165,6 @@ class Frame2D:
         for g, dofs, value in self._prescribed_values:
             g.x.array[dofs] = load_factor * value
 
-    def reaction(self, where: str, fint: PETSc.Vec) -> np.ndarray:
-        """Sum over the nodes of ``where`` of the assembled internal force (fx, fy, mz) (all ranks)."""
-        blocks = assembly.owned_dofs_of_vertices(self.V, self.tmesh.vertices(where))
-        with fint.localForm() as f:
-            local = f.array.reshape(-1, 3)[blocks].sum(axis=0) if len(blocks) else np.zeros(3)
-        return assembly.global_sum(self.V.mesh.comm, np.asarray(local, dtype=float))
-
     def _rotation_free_vertices(self) -> np.ndarray:
         """Vertices touched by no bending element: their rotation has no stiffness and is fixed."""
         mesh = self.tmesh.mesh
@@ -169,19 +185,17 @@ class Frame2D:
     def external_force(self, b: PETSc.Vec) -> None:
         n_owned = self.V.dofmap.index_map.size_local
         with b.localForm() as bl:
-            arr = bl.array.reshape(-1, 3)
+            arr = bl.array.reshape(-1, self.ndof)
             for vertices, values in self._loads:
                 blocks = assembly.owned_dofs_of_vertices(self.V, vertices)
                 arr[blocks[blocks < n_owned]] += values
 
-    def update(self, dx: PETSc.Vec) -> None:
-        """Displacements add; planar rotations compose, which for SO(2) is exact addition of angles."""
-        self.state.vector.axpy(1.0, dx)
-        self.state.x.scatter_forward()
-
-    def extrapolate(self, older: np.ndarray, newer: np.ndarray, factor: float) -> None:
-        """x = newer + factor (newer − older): angles of SO(2) extrapolate linearly."""
-        self.state.x.array[:] = newer + factor * (newer - older)
+    def reaction(self, where: str, fint: PETSc.Vec) -> np.ndarray:
+        """Sum over the nodes of ``where`` of an assembled nodal vector (all ranks)."""
+        blocks = assembly.owned_dofs_of_vertices(self.V, self.tmesh.vertices(where))
+        with fint.localForm() as f:
+            local = f.array.reshape(-1, self.ndof)[blocks].sum(axis=0) if len(blocks) else np.zeros(self.ndof)
+        return assembly.global_sum(self.V.mesh.comm, np.asarray(local, dtype=float))
 
     def checkpoint(self) -> np.ndarray:
         return self.state.x.array.copy()
@@ -199,46 +213,151 @@ class Frame2D:
         return ids
 
     def to_global(self, local: np.ndarray) -> np.ndarray | None:
-        """Gather a local (blocks, 3) array to rank 0, ordered by input node number (None elsewhere)."""
+        """Gather a local nodal array (blocks, k) to rank 0, ordered by input node number."""
         n_owned = self.V.dofmap.index_map.size_local
+        nblocks = n_owned + self.V.dofmap.index_map.num_ghosts
         comm = self.V.mesh.comm
+        local = np.asarray(local).reshape(nblocks, -1)
         ids = comm.gather(self._input_ids()[:n_owned], root=0)
-        vals = comm.gather(np.asarray(local).reshape(-1, 3)[:n_owned], root=0)
+        vals = comm.gather(local[:n_owned], root=0)
         if comm.rank != 0:
             return None
-        out = np.empty((sum(len(i) for i in ids), 3))
+        out = np.empty((sum(len(i) for i in ids), local.shape[1]))
         for i, v in zip(ids, vals):
             out[i] = v
         return out
 
     def from_global(self, values: np.ndarray) -> np.ndarray:
-        """Local (blocks·3,) array (owned and ghost) from a node-ordered global (n, 3) array."""
-        ids = self._input_ids()
-        if values.shape != (self.V.dofmap.index_map.size_global, 3):
+        """Local flat array (owned and ghost blocks) from a node-ordered global (n, k) array."""
+        if values.shape[0] != self.V.dofmap.index_map.size_global:
             raise ValueError(f"the checkpoint holds {values.shape[0]} nodes; this model has "
                              f"{self.V.dofmap.index_map.size_global}: it was written for another mesh")
-        return values[ids].ravel()
+        return values[self._input_ids()].ravel()
 
     # -- read-out -------------------------------------------------------------
     def nodes(self) -> tuple[np.ndarray, np.ndarray]:
-        """(X (n, 2) initial positions, state (n, 3) = ux, uy, rz) of all nodes, on every rank."""
+        """(X (n, gdim) initial positions, state (n, state_size)) of all nodes, on every rank."""
         n_owned = self.V.dofmap.index_map.size_local
-        X = self.V.tabulate_dof_coordinates()[:n_owned, :2]
-        state = self.state.x.array.reshape(-1, 3)[:n_owned]
+        X = self.V.tabulate_dof_coordinates()[:n_owned, : self.gdim]
+        state = self.state.x.array.reshape(-1, self.state_size)[:n_owned]
         comm = self.V.mesh.comm
         return np.concatenate(comm.allgather(X)), np.concatenate(comm.allgather(state))
 
     def nodal_values(self, where: str) -> np.ndarray:
-        """(ux, uy, rz) of the first node of group ``where``, identical on every rank."""
+        """Values of the dofs of the first node of group ``where``, identical on every rank."""
         blocks = assembly.owned_dofs_of_vertices(self.V, self.tmesh.vertices(where))
         comm = self.V.mesh.comm
-        local = np.zeros(4)
+        local = np.zeros(self.ndof + 1)
         if len(blocks):
-            local[:3] = self.state.x.array.reshape(-1, 3)[blocks[0]]
-            local[3] = 1.0
-        # the group's first node is owned by exactly one rank; take the lowest such rank
-        owners = comm.allgather(local)
-        for v in owners:
-            if v[3] == 1.0:
-                return v[:3].copy()
+            local[: self.ndof] = self._dof_values(self.state.x.array.reshape(-1, self.state_size)[blocks[0]])
+            local[self.ndof] = 1.0
+        for v in comm.allgather(local):
+            if v[self.ndof] == 1.0:
+                return v[: self.ndof].copy()
         raise ValueError(f"group '{where}' has no node")
+
+
+class Frame2D(LineFrame):
+    """Beams and bars on one 1D mesh with gdim = 2; dofs (ux, uy, rz) per node."""
+
+    gdim = 2
+    dof_names = ("ux", "uy", "rz")
+    translations = 2
+    state_size = 3
+    nprops = law2d.NPROPS
+    kernels = kernels2d
+
+    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
+        super().__init__(tmesh, large_rotations)
+        self.state = dolfinx.fem.Function(self.V, name="state")  # state and corrections share V
+
+    def add_beam(self, where, EA, EI, GAs, N0, kind):
+        law2d.check_props(EA, EI, GAs, f"{kind} '{where}'")
+        return self.add_elements(where, np.array([EA, EI, GAs, N0]), EI > 0.0, kind)
+
+    def update(self, dx: PETSc.Vec) -> None:
+        """Displacements add; planar rotations compose, which for SO(2) is exact addition of angles."""
+        self.state.vector.axpy(1.0, dx)
+        self.state.x.scatter_forward()
+
+    def extrapolate(self, older: np.ndarray, newer: np.ndarray, factor: float) -> None:
+        """x = newer + factor (newer − older): angles of SO(2) extrapolate linearly."""
+        self.state.x.array[:] = newer + factor * (newer - older)
+
+    def displacement_vector(self) -> PETSc.Vec:
+        return self.state.vector
+
+    @staticmethod
+    def _dof_values(s: np.ndarray) -> np.ndarray:
+        return s
+
+
+@numba.njit(cache=True)
+def _update_quaternions(state, dx, n):
+    """state (n, 7) ← (u + du, exp(dw)∘q) for the first n nodes; dx (n, 6)."""
+    for i in range(n):
+        for k in range(3):
+            state[i, k] += dx[i, k]
+        state[i, 3:7] = rotations.quat_update(state[i, 3:7], dx[i, 3:6].copy())
+
+
+class Frame3D(LineFrame):
+    """Beams and bars on one 1D mesh with gdim = 3; dofs (ux, uy, uz, rx, ry, rz) per node,
+    the rotational ones spatial spins composed multiplicatively with the nodal rotations."""
+
+    gdim = 3
+    dof_names = ("ux", "uy", "uz", "rx", "ry", "rz")
+    translations = 3
+    state_size = kernels3d.NSTATE
+    nprops = law3d.NPROPS
+    kernels = kernels3d
+    symmetric_tangent = False  # spatial spins: K is symmetric only at equilibrium under conservative loads
+
+    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
+        super().__init__(tmesh, large_rotations)
+        S = dolfinx.fem.VectorFunctionSpace(tmesh.mesh, ("Lagrange", 1), dim=kernels3d.NSTATE)
+        self.state = dolfinx.fem.Function(S, name="state")
+        self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, 3] = 1.0  # identity rotations
+        self._disp = dolfinx.fem.Function(self.V, name="displacement")
+
+    def add_beam(self, where, values: dict, orientation, N0: float, kind: str):
+        label = f"{kind} '{where}'"
+        law3d.check_props(values, label)
+        v = np.asarray(orientation, dtype=float)
+        if v.shape != (3,) or not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0.0:
+            raise ValueError(f"{label}: orientation must be a non-zero 3-vector, got {orientation}")
+        props = np.array([values["EA"], values["GJ"], values["EIy"], values["EIz"], values["GAy"], values["GAz"],
+                          N0, *v])
+        bending = values["EIy"] > 0.0 or values["EIz"] > 0.0
+        return self.add_elements(where, props, bending, kind)
+
+    def _check_geometry(self, cells, label, props):
+        super()._check_geometry(cells, label, props)
+        _, d = self._element_vectors(cells)
+        v = props[-3:]
+        c = np.abs(d @ v) / (np.linalg.norm(d, axis=1) * np.linalg.norm(v))
+        bad = np.flatnonzero(c > 1.0 - 1e-8)
+        if len(bad):
+            raise ValueError(f"{label}: the orientation vector {v.tolist()} is parallel to {len(bad)} element(s); "
+                             "choose one that fixes the local y axis")
+
+    def update(self, dx: PETSc.Vec) -> None:
+        """u ← u + du; q ← exp(dw)∘q (multiplicative, spatial), owned and ghost nodes alike."""
+        with dx.localForm() as d:
+            inc = d.array.reshape(-1, 6)
+            st = self.state.x.array.reshape(-1, kernels3d.NSTATE)
+            _update_quaternions(st, inc, inc.shape[0])
+
+    def extrapolate(self, older, newer, factor):
+        raise NotImplementedError("the secant predictor is not available for 3D rotations; "
+                                  "use LoadControl(extrapolate=False)")
+
+    def displacement_vector(self) -> PETSc.Vec:
+        """Displacements in the layout of the corrections (rotational entries 0), for constraints."""
+        arr = self._disp.x.array.reshape(-1, 6)
+        arr[:, :3] = self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, :3]
+        return self._disp.vector
+
+    @staticmethod
+    def _dof_values(s: np.ndarray) -> np.ndarray:
+        return np.concatenate([s[:3], rotations.rotvec_from_quat(s[3:7].copy())])

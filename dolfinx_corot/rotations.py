@@ -143,8 +143,8 @@ def rotvec_from_quat(q):
     s = np.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2)
     t = 2.0 * np.arctan2(s, w)  # in [0, π]
     if s < 1e-8:
-        # t/s = 2/w (1 + s²/(3w²)) + O(s⁴): exact to rounding here
-        return v * (2.0 / w) * (1.0 + s * s / (3.0 * w * w))
+        # t/s = (2/w)·atan(s/w)/(s/w) = (2/w)(1 − s²/(3w²)) + O(s⁴): exact to rounding here
+        return v * (2.0 / w) * (1.0 - s * s / (3.0 * w * w))
     return v * (t / s)
 
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from .io.mesh import TaggedMesh
 from .materials import Elastic
-from .parts import Frame2D, PartRef
+from .parts import Frame2D, Frame3D, LineFrame, PartRef
 from .sections import Section
 
 KINEMATICS = ("bernoulli", "timoshenko")
@@ -46,13 +46,13 @@ class Scene:
 
     def __init__(self, large_rotations: bool = True):
         self.large_rotations = bool(large_rotations)
-        self._models: dict[int, Frame2D] = {}
+        self._models: dict[int, LineFrame] = {}
         self.monitors: list[Monitor] = []
         self._loads = 0
         self._prescribed = 0
 
     # -- parts -----------------------------------------------------------------
-    def _model(self, tmesh: TaggedMesh) -> Frame2D:
+    def _model(self, tmesh: TaggedMesh) -> LineFrame:
         if not isinstance(tmesh, TaggedMesh):
             raise TypeError(f"expected a TaggedMesh from dolfinx_corot.io.from_gmsh, got {type(tmesh).__name__}")
         key = id(tmesh)
@@ -60,27 +60,34 @@ class Scene:
             if self._models:
                 raise NotImplementedError("all structural parts must share one mesh (parts on different "
                                           "meshes are coupled in a later release); put every group in one gmsh model")
-            self._models[key] = Frame2D(tmesh, self.large_rotations)
+            frame = Frame3D if tmesh.mesh.geometry.dim == 3 else Frame2D
+            self._models[key] = frame(tmesh, self.large_rotations)
         return self._models[key]
 
     def add_beam(self, tmesh: TaggedMesh, where: str | None = None, *, section: Section,
-                 material: Elastic, kinematics: str = "bernoulli") -> PartRef:
+                 material: Elastic, kinematics: str = "bernoulli", orientation=(0.0, 0.0, 1.0)) -> PartRef:
         """Beam elements on the cells of group ``where`` (all cells if None).
 
         kinematics: 'bernoulli' (no shear deformation) or 'timoshenko' (shear
-        area ``section.As``, shear modulus ``material.G``).
+        area ``section.As``, shear modulus ``material.G``). In 3D,
+        ``orientation`` is a vector whose part normal to each element is the
+        local y axis (``section.Iz`` is about the local z axis, ``section.Iy``
+        about y); it is ignored in 2D.
         """
         if kinematics not in KINEMATICS:
             raise ValueError(f"kinematics '{kinematics}' is not one of {KINEMATICS}")
         if not isinstance(material, Elastic):
             raise TypeError(f"beam '{where}': material must be dc.Elastic, got {type(material).__name__}")
-        GAs = 0.0
-        if kinematics == "timoshenko":
-            if section.As <= 0.0:
-                raise ValueError(f"beam '{where}': Timoshenko kinematics needs a shear area As > 0")
-            GAs = material.G * section.As
-        return self._model(tmesh).add_elements(where, material.E * section.A, material.E * section.I,
-                                               GAs, 0.0, "beam")
+        model = self._model(tmesh)
+        E, G = material.E, material.G
+        if kinematics == "timoshenko" and section.As <= 0.0:
+            raise ValueError(f"beam '{where}': Timoshenko kinematics needs a shear area As > 0")
+        GAs = G * section.As if kinematics == "timoshenko" else 0.0
+        if isinstance(model, Frame2D):
+            return model.add_beam(where, E * section.A, E * section.I, GAs, 0.0, "beam")
+        return model.add_beam(where, {"EA": E * section.A, "GJ": G * section.torsion_constant,
+                                      "EIy": E * section.second_moment_y, "EIz": E * section.I,
+                                      "GAy": GAs, "GAz": GAs}, orientation, 0.0, "beam")
 
     def add_truss(self, tmesh: TaggedMesh, where: str | None = None, *, area: float, material: Elastic,
                   prestress_force: float = 0.0) -> PartRef:
@@ -92,7 +99,15 @@ class Scene:
             raise TypeError(f"truss '{where}': material must be dc.Elastic, got {type(material).__name__}")
         if not area > 0.0:
             raise ValueError(f"truss '{where}': area = {area} must be positive")
-        return self._model(tmesh).add_elements(where, material.E * area, 0.0, 0.0, float(prestress_force), "truss")
+        model = self._model(tmesh)
+        if isinstance(model, Frame2D):
+            return model.add_beam(where, material.E * area, 0.0, 0.0, float(prestress_force), "truss")
+        _, d = model._element_vectors(tmesh.cells(where))
+        # any vector not parallel to the bars orients their (unused) local axes
+        v = np.array([0.0, 0.0, 1.0]) if np.all(np.abs(d[:, 2]) < 0.9 * np.linalg.norm(d, axis=1)) \
+            else np.array([1.0, 0.0, 0.0])
+        return model.add_beam(where, {"EA": material.E * area, "GJ": 0.0, "EIy": 0.0, "EIz": 0.0, "GAy": 0.0,
+                                      "GAz": 0.0}, v, float(prestress_force), "truss")
 
     # -- conditions ------------------------------------------------------------
     def fix(self, part: PartRef, where: str, dofs: tuple[str, ...] | None = None) -> None:
@@ -122,13 +137,22 @@ class Scene:
             model.prescribe(where, names.index(dof), float(value))
         self._prescribed += 1
 
-    def load(self, part: PartRef, where: str, force=(0.0, 0.0), moment: float = 0.0) -> None:
-        """Dead point force (fx, fy) and moment mz at each node of ``where``, scaled by the load factor."""
-        force = np.asarray(force, dtype=float)
-        if force.shape != (2,) or not np.all(np.isfinite(force)) or not np.isfinite(moment):
-            raise ValueError(f"load '{where}': force must be two finite numbers and moment finite; "
-                             f"got force={force.tolist()}, moment={moment}")
-        part.model.add_load(where, np.array([force[0], force[1], moment]))
+    def load(self, part: PartRef, where: str, force=None, moment=None) -> None:
+        """Dead point force and moment at each node of ``where``, scaled by the load factor.
+
+        2D: force (fx, fy), moment mz (a number). 3D: force (fx, fy, fz),
+        moment (mx, my, mz), a fixed spatial vector.
+        """
+        g = part.model.gdim
+        nm = 1 if g == 2 else 3
+        force = np.zeros(g) if force is None else np.atleast_1d(np.asarray(force, dtype=float))
+        moment = np.zeros(nm) if moment is None else np.atleast_1d(np.asarray(moment, dtype=float))
+        if force.shape != (g,) or moment.shape != (nm,) or not (np.all(np.isfinite(force))
+                                                             and np.all(np.isfinite(moment))):
+            raise ValueError(f"load '{where}': in {g}D give force as {g} finite numbers and moment as "
+                             f"{'a number' if nm == 1 else '3 numbers'}; got force={force.tolist()}, "
+                             f"moment={moment.tolist()}")
+        part.model.add_load(where, np.concatenate([force, moment]))
         self._loads += 1
 
     def monitor(self, name: str, part: PartRef, where: str) -> None:
@@ -144,7 +168,7 @@ class Scene:
 
     # -- introspection -----------------------------------------------------------
     @property
-    def model(self) -> Frame2D:
+    def model(self) -> LineFrame:
         if not self._models:
             raise ValueError("the scene has no parts: add a beam or a truss first")
         return next(iter(self._models.values()))
@@ -155,7 +179,7 @@ class Scene:
         for m in self._models.values():
             kinds = sorted({p.kind for p in m.parts})
             frame = "co-rotational" if self.large_rotations else "geometrically linear"
-            out.append(f"{' and '.join(kinds)} elements ({frame}, 2D)")
+            out.append(f"{' and '.join(kinds)} elements ({frame}, {m.gdim}D)")
         if self._loads:
             out.append("point loads (dead)")
         if self._prescribed:
@@ -171,7 +195,8 @@ class Scene:
                 # reaction on the structure = λ f_ext − f_int at the constrained nodes
                 fint = model.reaction(mon.where, system.internal_force())
                 fext = model.reaction(mon.where, system.fext) * system.load_factor
-                for comp, val in zip(("Fx", "Fy", "Mz"), fext - fint):
+                names = ("Fx", "Fy", "Mz") if model.gdim == 2 else ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
+                for comp, val in zip(names, fext - fint):
                     values[f"{mon.name}_{comp}"] = -float(val)
             else:
                 for comp, val in zip(model.dof_names, model.nodal_values(mon.where)):

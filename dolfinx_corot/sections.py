@@ -11,14 +11,28 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class Section:
-    """General section: area A, second moment I, shear area As (k·A)."""
+    """General section: area A, second moment I (about the local z axis; the in-plane
+    bending of 2D beams), shear area As (k·A); in 3D also Iy (about the local y axis,
+    default I) and the torsion constant J (default Iy + I, the polar moment)."""
 
     A: float
     I: float
     As: float = 0.0
+    Iy: float | None = None
+    J: float | None = None
+
+    @property
+    def second_moment_y(self) -> float:
+        return self.I if self.Iy is None else self.Iy
+
+    @property
+    def torsion_constant(self) -> float:
+        return self.second_moment_y + self.I if self.J is None else self.J
 
     def __post_init__(self):
-        for name in ("A", "I", "As"):
+        for name in ("A", "I", "As", "Iy", "J"):
+            if getattr(self, name) is None:
+                continue
             v = getattr(self, name)
             if not math.isfinite(v) or v < 0.0:
                 raise ValueError(f"{type(self).__name__}: {name} = {v} must be finite and not negative")
@@ -27,10 +41,14 @@ class Section:
 
 
 def Rectangle(b: float, h: float, shear_factor: float = 5.0 / 6.0) -> Section:
-    """Rectangle of width b (out of plane) and depth h (in plane): A = bh, I = bh³/12, As = k·A."""
+    """Rectangle of width b (along local z) and depth h (along local y; in plane in 2D):
+    A = bh, I = bh³/12 (about z), Iy = hb³/12, As = k·A, J = Saint-Venant β·a·c³
+    (a ≥ c the sides; Roark's series)."""
     if not (b > 0.0 and h > 0.0):
         raise ValueError(f"Rectangle: b = {b} and h = {h} must be positive")
-    return Section(A=b * h, I=b * h**3 / 12.0, As=shear_factor * b * h)
+    a, c = max(b, h), min(b, h)
+    J = a * c**3 * (1.0 / 3.0 - 0.21 * (c / a) * (1.0 - (c / a) ** 4 / 12.0))
+    return Section(A=b * h, I=b * h**3 / 12.0, As=shear_factor * b * h, Iy=h * b**3 / 12.0, J=J)
 
 
 def Circle(d: float, shear_factor: float = 0.9) -> Section:
@@ -38,4 +56,5 @@ def Circle(d: float, shear_factor: float = 0.9) -> Section:
     if not d > 0.0:
         raise ValueError(f"Circle: diameter d = {d} must be positive")
     A = math.pi * d * d / 4.0
-    return Section(A=A, I=math.pi * d**4 / 64.0, As=shear_factor * A)
+    return Section(A=A, I=math.pi * d**4 / 64.0, As=shear_factor * A, Iy=math.pi * d**4 / 64.0,
+                   J=math.pi * d**4 / 32.0)

@@ -6,6 +6,6 @@ Each frame maps global nodal displacements/rotations ``d`` to deformations
 Nour-Omid 1988, 1990; seed §2.1). The element law that produces ``f̄, K̄``
 lives in :mod:`dolfinx_corot.elements` and never sees the frame.
 """
-from . import frame2d
+from . import frame2d, frame3d
 
-__all__ = ["frame2d"]
+__all__ = ["frame2d", "frame3d"]

@@ -342,11 +342,11 @@ class Frame3D(LineFrame):
                              "choose one that fixes the local y axis")
 
     def update(self, dx: PETSc.Vec) -> None:
-        """u ← u + du; q ← exp(dw)∘q (multiplicative, spatial), owned and ghost nodes alike."""
-        with dx.localForm() as d:
-            inc = d.array.reshape(-1, 6)
-            st = self.state.x.array.reshape(-1, kernels3d.NSTATE)
-            _update_quaternions(st, inc, inc.shape[0])
+        """u ← u + du; q ← exp(dw)∘q (multiplicative, spatial) on owned nodes; ghosts from their owners."""
+        n_owned = self.V.dofmap.index_map.size_local
+        st = self.state.x.array.reshape(-1, kernels3d.NSTATE)
+        _update_quaternions(st, dx.array_r.reshape(-1, 6), n_owned)
+        self.state.x.scatter_forward()
 
     def extrapolate(self, older, newer, factor):
         raise NotImplementedError("the secant predictor is not available for 3D rotations; "

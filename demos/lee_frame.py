@@ -33,6 +33,7 @@ from mpi4py import MPI
 import dolfinx_corot as dc
 from dolfinx_corot.io import output_dir
 from dolfinx_corot.io.gmsh_models import polyline
+from dolfinx_corot.result import limit_load
 
 comm = MPI.COMM_WORLD
 logging.basicConfig(level=logging.WARNING)
@@ -59,15 +60,6 @@ def lee_frame(n):
     return scene
 
 
-def limit_point(lam, u, v, which=np.argmax):
-    """Load extremum from a parabola through the three path points around it (path length as parameter)."""
-    s = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(u), np.diff(v)))])
-    k = int(which(lam))
-    k = min(max(k, 1), len(lam) - 2)
-    c = np.polyfit(s[k - 1:k + 2], lam[k - 1:k + 2], 2)
-    return c[2] - c[1] ** 2 / (4 * c[0])
-
-
 # %% [markdown]
 # ## The path with 20 elements
 
@@ -92,9 +84,8 @@ if comm.rank == 0:
     result.write(out)
 lam, u, v = hist.column("load_factor"), hist.column("P_ux"), hist.column("P_uy")
 lam0, u0, v0 = np.r_[0.0, lam], np.r_[0.0, u], np.r_[0.0, v]
-first = int(np.argmax(np.diff(lam0) < 0))  # the path turns down after its first maximum
-P_max = limit_point(lam0[: first + 2], u0[: first + 2], v0[: first + 2])
-P_min = limit_point(lam0, u0, v0, np.argmin)
+P_max = limit_load(lam0, u0, v0)  # the first maximum, refined by a parabola along the path
+P_min = limit_load(lam0, u0, v0, kind="min", first=False)
 iters = hist.column("iterations")
 say(f"{len(hist)} arc-length steps, {result.totals['newton_iterations']} iterations, "
     f"{result.totals['cuts']} cuts, {wall:.2f} s; iterations per step {int(iters.min())}-{int(iters.max())}")
@@ -112,9 +103,8 @@ for n in ([1, 2] if os.environ.get("CI") == "true" else [1, 2, 4]):
     dt = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
     lm = np.r_[0.0, r.history.column("load_factor")]
     uu, vv = np.r_[0.0, r.history.column("P_ux")], np.r_[0.0, r.history.column("P_uy")]
-    f1 = int(np.argmax(np.diff(lm) < 0))
-    pm = limit_point(lm[: f1 + 2], uu[: f1 + 2], vv[: f1 + 2])
-    study.append((20 * n, pm, limit_point(lm, uu, vv, np.argmin), dt, r.totals["cuts"]))
+    pm = limit_load(lm, uu, vv)
+    study.append((20 * n, pm, limit_load(lm, uu, vv, kind="min", first=False), dt, r.totals["cuts"]))
     say(f"{20 * n:3d} elements: P_max L²/EI = {pm:.4f}, P_min L²/EI = {study[-1][2]:.4f}, "
         f"{dt:.2f} s, {r.totals['cuts']} cuts")
 study = np.array(study)

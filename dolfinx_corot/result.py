@@ -60,3 +60,27 @@ class Result:
         with open(os.path.join(directory, f"{name}_summary.json"), "w") as f:
             json.dump({"completed": self.completed, "message": self.message, **self.totals}, f, indent=1)
         return path
+
+
+def limit_load(load: np.ndarray, *coordinates: np.ndarray, kind: str = "max", first: bool = True) -> float:
+    """Load extremum of a traced equilibrium path, refined by a parabola through the three
+    path points around it, with the path length in ``coordinates`` as parameter.
+
+    load: (n,) load factors along the path (start at the unloaded state for a
+    first maximum); coordinates: (n,) arrays, e.g. monitored displacements;
+    kind: 'max' or 'min'; first: the first local extremum instead of the global one.
+    """
+    lam = np.asarray(load, dtype=float)
+    xs = np.array([np.asarray(c, dtype=float) for c in coordinates])
+    sign = 1.0 if kind == "max" else -1.0
+    if first:
+        turns = np.flatnonzero(sign * np.diff(lam) < 0)
+        stop = turns[0] + 1 if len(turns) else len(lam) - 1
+        k = int(np.argmax(sign * lam[: stop + 1]))
+    else:
+        k = int(np.argmax(sign * lam))
+    if k == 0 or k == len(lam) - 1:
+        return float(lam[k])
+    s = np.concatenate([[0.0], np.cumsum(np.sqrt((np.diff(xs, axis=1) ** 2).sum(axis=0)))])
+    c = np.polyfit(s[k - 1:k + 2], lam[k - 1:k + 2], 2)
+    return float(c[2] - c[1] ** 2 / (4 * c[0]))

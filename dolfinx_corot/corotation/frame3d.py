@@ -82,16 +82,18 @@ def exp_spin(w, R):
         t = np.sqrt(t2)
         a = np.sin(t) / t
         b = (1.0 - np.cos(t)) / t2
-    W = np.zeros((3, 3), dtype=R.dtype)
-    W[0, 1] = -w[2]
-    W[0, 2] = w[1]
-    W[1, 0] = w[2]
-    W[1, 2] = -w[0]
-    W[2, 0] = -w[1]
-    W[2, 1] = w[0]
-    R[:, :] = b * (W @ W) + a * W
+    # I + aW + bW² with W² = w wᵀ − |w|² I
+    d = 1.0 - b * t2
     for i in range(3):
-        R[i, i] += 1.0
+        for j in range(3):
+            R[i, j] = b * w[i] * w[j]
+        R[i, i] += d
+    R[0, 1] -= a * w[2]
+    R[0, 2] += a * w[1]
+    R[1, 0] += a * w[2]
+    R[1, 2] -= a * w[0]
+    R[2, 0] -= a * w[1]
+    R[2, 1] += a * w[0]
 
 
 @numba.njit(cache=True)
@@ -124,16 +126,18 @@ def tangent_inverse(th, Ti):
         t = np.sqrt(t2)
         h = 0.5 * t
         c = (1.0 - h * np.cos(h) / np.sin(h)) / t2
-    W = np.zeros((3, 3), dtype=Ti.dtype)
-    W[0, 1] = -th[2]
-    W[0, 2] = th[1]
-    W[1, 0] = th[2]
-    W[1, 2] = -th[0]
-    W[2, 0] = -th[1]
-    W[2, 1] = th[0]
-    Ti[:, :] = c * (W @ W) - 0.5 * W
+    # I − ½Θ + cΘ² with Θ² = θθᵀ − |θ|² I
+    d = 1.0 - c * t2
     for i in range(3):
-        Ti[i, i] += 1.0
+        for j in range(3):
+            Ti[i, j] = c * th[i] * th[j]
+        Ti[i, i] += d
+    Ti[0, 1] += 0.5 * th[2]
+    Ti[0, 2] -= 0.5 * th[1]
+    Ti[1, 0] -= 0.5 * th[2]
+    Ti[1, 2] += 0.5 * th[0]
+    Ti[2, 0] += 0.5 * th[1]
+    Ti[2, 1] -= 0.5 * th[0]
 
 
 @numba.njit(cache=True)
@@ -157,6 +161,22 @@ def initial_frame(X1, X2, v, R0):
     return l0
 
 
+@numba.njit(cache=True, inline="always")
+def _mat3(A, B, C):
+    """C = A B for 3×3 arrays (explicit loops: no BLAS call for tiny blocks)."""
+    for i in range(3):
+        for j in range(3):
+            C[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
+
+
+@numba.njit(cache=True, inline="always")
+def _mat3_tn(A, B, C):
+    """C = Aᵀ B for 3×3 arrays."""
+    for i in range(3):
+        for j in range(3):
+            C[i, j] = A[0, i] * B[0, j] + A[1, i] * B[1, j] + A[2, i] * B[2, j]
+
+
 @numba.njit(cache=True)
 def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
     """Basic deformations of the current configuration and B = ∂d̄/∂d (7, 12).
@@ -170,8 +190,11 @@ def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
         dx[k] = X2[k] + u2[k] - X1[k] - u1[k]
     l = np.sqrt(dot(dx, dx))
     e1 = dx / l
-    p1 = R1 @ R0[:, 1].astype(dt)
-    p2 = R2 @ R0[:, 1].astype(dt)
+    p1 = np.empty(3, dtype=dt)
+    p2 = np.empty(3, dtype=dt)
+    for k in range(3):
+        p1[k] = R1[k, 0] * R0[0, 1] + R1[k, 1] * R0[1, 1] + R1[k, 2] * R0[2, 1]
+        p2[k] = R2[k, 0] * R0[0, 1] + R2[k, 1] * R0[1, 1] + R2[k, 2] * R0[2, 1]
     p = 0.5 * (p1 + p2)
     e3 = np.empty(3, dtype=dt)
     cross(e1, p, e3)
@@ -183,37 +206,49 @@ def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
         Rr[k, 0] = e1[k]
         Rr[k, 1] = e2[k]
         Rr[k, 2] = e3[k]
-    R0c = R0.astype(dt)
-    log_rotation(Rr.T @ R1 @ R0c, th1)
-    log_rotation(Rr.T @ R2 @ R0c, th2)
+    T = np.empty((3, 3), dtype=dt)
+    Rb = np.empty((3, 3), dtype=dt)
+    R0c = np.empty((3, 3), dtype=dt)
+    for i in range(3):
+        for j in range(3):
+            R0c[i, j] = R0[i, j]
+    _mat3_tn(Rr, R1, T)
+    _mat3(T, R0c, Rb)
+    log_rotation(Rb, th1)
+    _mat3_tn(Rr, R2, T)
+    _mat3(T, R0c, Rb)
+    log_rotation(Rb, th2)
     ubar = (l * l - l0 * l0) / (l + l0)
-    # local components of p, p1, p2
-    pl = Rr.T @ p
-    p1l = Rr.T @ p1
-    p2l = Rr.T @ p2
-    eta = pl[0] / pl[1]
+    # local components of p, p1, p2 (only the first two are needed)
+    pl0 = dot(e1, p)
+    pl1 = dot(e2, p)
+    eta = pl0 / pl1
     GT = np.zeros((3, 12), dtype=dt)
     GT[0, 2] = eta / l
-    GT[0, 3] = 0.5 * p1l[1] / pl[1]
-    GT[0, 4] = -0.5 * p1l[0] / pl[1]
+    GT[0, 3] = 0.5 * dot(e2, p1) / pl1
+    GT[0, 4] = -0.5 * dot(e1, p1) / pl1
     GT[0, 8] = -eta / l
-    GT[0, 9] = 0.5 * p2l[1] / pl[1]
-    GT[0, 10] = -0.5 * p2l[0] / pl[1]
+    GT[0, 9] = 0.5 * dot(e2, p2) / pl1
+    GT[0, 10] = -0.5 * dot(e1, p2) / pl1
     GT[1, 2] = 1.0 / l
     GT[1, 8] = -1.0 / l
     GT[2, 1] = -1.0 / l
     GT[2, 7] = 1.0 / l
-    # rows in local components, then rotated to global: columns block k → block·Rrᵀ
+    # B in local components: row ū and rows T⁻¹(θ̄_i)(S_i − Gᵀ); then columns rotated by Rrᵀ
     Bl = np.zeros((7, 12), dtype=dt)
     Bl[0, 0] = -1.0
     Bl[0, 6] = 1.0
     Ti = np.empty((3, 3), dtype=dt)
-    for i, th in ((0, th1), (1, th2)):
-        tangent_inverse(th, Ti)
-        A = -GT.copy()
-        for k in range(3):
-            A[k, 3 + 6 * i + k] += 1.0
-        Bl[1 + 3 * i:4 + 3 * i, :] = Ti @ A
-    for blk in range(4):
-        B[:, 3 * blk:3 * blk + 3] = Bl[:, 3 * blk:3 * blk + 3] @ Rr.T
+    for i in range(2):
+        tangent_inverse(th1 if i == 0 else th2, Ti)
+        for r in range(3):
+            for c in range(12):
+                Bl[1 + 3 * i + r, c] = -(Ti[r, 0] * GT[0, c] + Ti[r, 1] * GT[1, c] + Ti[r, 2] * GT[2, c])
+            for k in range(3):
+                Bl[1 + 3 * i + r, 3 + 6 * i + k] += Ti[r, k]
+    for r in range(7):
+        for blk in range(4):
+            c0 = 3 * blk
+            for j in range(3):
+                B[r, c0 + j] = Bl[r, c0] * Rr[j, 0] + Bl[r, c0 + 1] * Rr[j, 1] + Bl[r, c0 + 2] * Rr[j, 2]
     return ubar

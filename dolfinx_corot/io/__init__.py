@@ -1,7 +1,7 @@
 """Input and output: gmsh meshes with named groups, history files, plots."""
-from .mesh import GroupNotFoundError, TaggedMesh, from_gmsh
+from .mesh import GroupNotFoundError, TaggedMesh, from_arrays, from_gmsh
 
-__all__ = ["GroupNotFoundError", "TaggedMesh", "from_gmsh", "output_dir", "reference"]
+__all__ = ["GroupNotFoundError", "TaggedMesh", "from_arrays", "from_gmsh", "output_dir", "reference"]
 
 
 def output_dir(name: str) -> str:

@@ -41,7 +41,11 @@ def _force(X1, X2, u1, u2, R1, R2, R0, l0, props, f):
     ubar = frame3d.basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B)
     fbar = np.empty(7, dtype=dt)
     law.basic_force(l0, ubar, th1, th2, props, True, fbar)
-    f[:] = B.T @ fbar
+    for i in range(12):
+        acc = B[0, i] * fbar[0]
+        for r in range(1, 7):
+            acc += B[r, i] * fbar[r]
+        f[i] = acc
 
 
 @numba.njit(cache=True)
@@ -67,6 +71,11 @@ def corotational(X1, X2, s1, s2, props, f, K):
     for j in range(12):
         node = j // 6
         k = j % 3
+        if 6 <= j < 9:
+            # f depends on u2 − u1 only: the columns of u2 are minus those of u1
+            for i in range(12):
+                K[i, j] = -K[i, j - 6]
+            continue
         a1, a2, Q1, Q2 = u1c.copy(), u2c.copy(), R1c, R2c
         if j % 6 < 3:
             if node == 0:
@@ -78,9 +87,11 @@ def corotational(X1, X2, s1, s2, props, f, K):
             w[k] = 1j * H
             frame3d.exp_spin(w, E)
             if node == 0:
-                Q1 = E @ R1c
+                Q1 = np.empty((3, 3), dtype=np.complex128)
+                frame3d._mat3(E, R1c, Q1)
             else:
-                Q2 = E @ R2c
+                Q2 = np.empty((3, 3), dtype=np.complex128)
+                frame3d._mat3(E, R2c, Q2)
         _force(X1, X2, a1, a2, Q1, Q2, R0, l0, props, fc)
         for i in range(12):
             K[i, j] = fc[i].imag / H

@@ -5,6 +5,7 @@ follows the load path; :func:`solve` returns a :class:`Result` with the
 per-step history.
 """
 from . import rotations
+from .amplitudes import Amplitude
 from .io.mesh import GroupNotFoundError, TaggedMesh, from_gmsh
 from .materials import Elastic
 from .result import History, Result
@@ -14,6 +15,6 @@ from .solvers import ArcLength, ConvergenceError, LoadControl, NewtonOptions, so
 
 __version__ = "0.1.0"
 
-__all__ = ["ArcLength", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
+__all__ = ["Amplitude", "ArcLength", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
            "NewtonOptions", "Rectangle", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
            "rotations", "solve"]

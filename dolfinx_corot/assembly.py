@@ -104,6 +104,15 @@ class System:
         model.external_force(self.fext)
         self.fext.assemble()
         self._fext_norm = self.fext.norm()
+        # loads with their own amplitudes g(λ)
+        self.amplitude_loads = []
+        for amp in getattr(model, "amplitudes", []):
+            v = self.b.duplicate()
+            with v.localForm() as f:
+                f.set(0.0)
+            model.external_force(v, amp)
+            self.amplitude_loads.append((amp, v))
+        self.fext_total = self.b.duplicate()
         self.timings = Timings()
 
         if symmetric is None:
@@ -126,13 +135,13 @@ class System:
 
     # -- residual -----------------------------------------------------------
     def residual(self, load_factor: float) -> tuple[float, float]:
-        """Assemble b = λ f_ext − f_int; on constrained dofs b = ū(λ) − x (0 on supports).
+        """Assemble b = λ f_ext + Σ g(λ) f_g − f_int; on constrained dofs b = ū(λ) − x (0 on supports).
 
         With prescribed displacements the columns of constrained dofs are
         lifted, b_f −= K_fc (ū − x)_c, so that one Newton correction honours
         them exactly. Returns (‖b‖, reference force norm) where the
-        reference is the larger of ‖λ f_ext‖ and ‖f_int‖ over all dofs
-        (reactions included).
+        reference is the larger of the external load's norm and ‖f_int‖ over
+        all dofs (reactions included).
         """
         t = time.perf_counter()
         self.load_factor = load_factor
@@ -140,9 +149,12 @@ class System:
             f.set(0.0)
         dolfinx.fem.petsc.assemble_vector(self.fint, self.L)
         self.fint.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        ref = max(abs(load_factor) * self._fext_norm, self.fint.norm())
-        self.fext.copy(self.b)
-        self.b.scale(load_factor)
+        self.fext.copy(self.fext_total)
+        self.fext_total.scale(load_factor)
+        for amp, v in self.amplitude_loads:
+            self.fext_total.axpy(amp(load_factor), v)
+        ref = max(self.fext_total.norm(), self.fint.norm())
+        self.fext_total.copy(self.b)
         self.b.axpy(-1.0, self.fint)
         x = self.model.displacement_vector()
         if self._prescribed:
@@ -238,7 +250,8 @@ class System:
         return self.fint
 
     def destroy(self) -> None:
-        for obj in (self.ksp, self.A, self.b, self.fint, self.dx, self.step_dx, self.lift, self.fext):
+        for obj in (self.ksp, self.A, self.b, self.fint, self.dx, self.step_dx, self.lift, self.fext,
+                    self.fext_total, *(v for _, v in self.amplitude_loads)):
             obj.destroy()
 
 

@@ -68,9 +68,9 @@ class LineFrame:
         self._bending = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
         self.parts: list[PartRef] = []
         self._bcs: list[tuple[np.ndarray, tuple[int, ...]]] = []
-        self._loads: list[tuple[np.ndarray, np.ndarray]] = []
-        self._prescribed: list[tuple[np.ndarray, int, float]] = []
-        self._prescribed_values: list[tuple[dolfinx.fem.Function, np.ndarray, float]] = []
+        self._loads: list[tuple[np.ndarray, np.ndarray, object]] = []
+        self._prescribed: list[tuple[np.ndarray, int, float, object]] = []
+        self._prescribed_values: list[tuple[dolfinx.fem.Function, np.ndarray, float, object]] = []
         self._forms = None
 
     # -- building -----------------------------------------------------------
@@ -111,16 +111,25 @@ class LineFrame:
     def fix(self, where: str, dofs: tuple[int, ...]) -> None:
         self._bcs.append((self.tmesh.vertices(where), dofs))
 
-    def prescribe(self, where: str, comp: int, value: float) -> None:
-        """Prescribed displacement ``value``·λ of dof ``comp`` at the nodes of ``where``."""
+    def prescribe(self, where: str, comp: int, value: float, amplitude=None) -> None:
+        """Prescribed displacement ``value``·λ (or ·amplitude(λ)) of dof ``comp`` at the nodes of ``where``."""
         if comp >= self.translations and self.gdim == 3 and value != 0.0:
             raise NotImplementedError(f"prescribe '{where}': non-zero rotations ({self.dof_names[comp]}) "
                                       "cannot be prescribed in 3D; prescribe displacements or apply a moment")
-        self._prescribed.append((self.tmesh.vertices(where), comp, float(value)))
+        self._prescribed.append((self.tmesh.vertices(where), comp, float(value), amplitude))
 
-    def add_load(self, where: str, values: np.ndarray) -> None:
-        """Nodal load (forces, moments) at every node of group ``where`` (scaled by the load factor)."""
-        self._loads.append((self.tmesh.vertices(where), np.asarray(values, dtype=float)))
+    def add_load(self, where: str, values: np.ndarray, amplitude=None) -> None:
+        """Nodal load (forces, moments) at every node of group ``where``: λ·values, or amplitude(λ)·values."""
+        self._loads.append((self.tmesh.vertices(where), np.asarray(values, dtype=float), amplitude))
+
+    @property
+    def amplitudes(self) -> list:
+        """The distinct amplitudes of the loads (None: proportional to λ)."""
+        out = []
+        for _, _, amp in self._loads:
+            if amp is not None and amp not in out:
+                out.append(amp)
+        return out
 
     # -- Model protocol (assembly.System) ------------------------------------
     symmetric_tangent = True
@@ -148,22 +157,22 @@ class LineFrame:
                 dofs = dolfinx.fem.locate_dofs_topological(self.V.sub(comp), 0, vertices)
                 bcs.append(dolfinx.fem.dirichletbc(zero, dofs, self.V.sub(comp)))
         self._prescribed_values = []
-        for vertices, comp, value in self._prescribed:
+        for vertices, comp, value, amplitude in self._prescribed:
             Vi, _ = self.V.sub(comp).collapse()
             g = dolfinx.fem.Function(Vi)
             dofs = dolfinx.fem.locate_dofs_topological((self.V.sub(comp), Vi), 0, vertices)
             bcs.append(dolfinx.fem.dirichletbc(g, dofs, self.V.sub(comp)))
-            self._prescribed_values.append((g, dofs[1], value))
+            self._prescribed_values.append((g, dofs[1], value, amplitude))
         return bcs
 
     @property
     def has_prescribed_motion(self) -> bool:
-        return any(value != 0.0 for _, _, value in self._prescribed)
+        return any(value != 0.0 for _, _, value, _ in self._prescribed)
 
     def set_load_factor(self, load_factor: float) -> None:
-        """Set the prescribed displacements to λ times their values."""
-        for g, dofs, value in self._prescribed_values:
-            g.x.array[dofs] = load_factor * value
+        """Set the prescribed displacements to λ (or amplitude(λ)) times their values."""
+        for g, dofs, value, amplitude in self._prescribed_values:
+            g.x.array[dofs] = (load_factor if amplitude is None else amplitude(load_factor)) * value
 
     def _rotation_free_vertices(self) -> np.ndarray:
         """Vertices touched by no bending element: their rotation has no stiffness and is fixed."""
@@ -182,11 +191,14 @@ class LineFrame:
         flag.x.scatter_forward()
         return np.flatnonzero(flag.x.array[vert_to_dof] == 0.0).astype(np.int32)
 
-    def external_force(self, b: PETSc.Vec) -> None:
+    def external_force(self, b: PETSc.Vec, amplitude=None) -> None:
+        """Add the loads with the given amplitude (None: those proportional to λ) at unit factor."""
         n_owned = self.V.dofmap.index_map.size_local
         with b.localForm() as bl:
             arr = bl.array.reshape(-1, self.ndof)
-            for vertices, values in self._loads:
+            for vertices, values, amp in self._loads:
+                if amp is not amplitude:
+                    continue
                 blocks = assembly.owned_dofs_of_vertices(self.V, vertices)
                 arr[blocks[blocks < n_owned]] += values
 

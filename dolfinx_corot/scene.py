@@ -120,8 +120,9 @@ class Scene:
             raise ValueError(f"fix '{where}': unknown dof(s) {bad}; this part has {names}")
         model.fix(where, tuple(names.index(d) for d in dofs))
 
-    def prescribe(self, part: PartRef, where: str, **values: float) -> None:
-        """Prescribed displacement/rotation at the nodes of ``where``, scaled by the load factor.
+    def prescribe(self, part: PartRef, where: str, amplitude=None, **values: float) -> None:
+        """Prescribed displacement/rotation at the nodes of ``where``, scaled by the load factor
+        (or by ``amplitude(λ)``, a :class:`dolfinx_corot.Amplitude`).
 
         Example: ``scene.prescribe(beam, "tip", uy=-1.0)`` (displacement control:
         λ = 1 moves the tip by −1; read the force with :meth:`monitor_reaction`).
@@ -134,11 +135,12 @@ class Scene:
         for dof, value in values.items():
             if not np.isfinite(value):
                 raise ValueError(f"prescribe '{where}': {dof} = {value} is not finite")
-            model.prescribe(where, names.index(dof), float(value))
+            model.prescribe(where, names.index(dof), float(value), amplitude)
         self._prescribed += 1
 
-    def load(self, part: PartRef, where: str, force=None, moment=None) -> None:
-        """Dead point force and moment at each node of ``where``, scaled by the load factor.
+    def load(self, part: PartRef, where: str, force=None, moment=None, amplitude=None) -> None:
+        """Dead point force and moment at each node of ``where``, scaled by the load factor λ
+        or, with an ``amplitude`` (:class:`dolfinx_corot.Amplitude`), by amplitude(λ).
 
         2D: force (fx, fy), moment mz (a number). 3D: force (fx, fy, fz),
         moment (mx, my, mz), a fixed spatial vector.
@@ -152,7 +154,7 @@ class Scene:
             raise ValueError(f"load '{where}': in {g}D give force as {g} finite numbers and moment as "
                              f"{'a number' if nm == 1 else '3 numbers'}; got force={force.tolist()}, "
                              f"moment={moment.tolist()}")
-        part.model.add_load(where, np.concatenate([force, moment]))
+        part.model.add_load(where, np.concatenate([force, moment]), amplitude)
         self._loads += 1
 
     def monitor(self, name: str, part: PartRef, where: str) -> None:
@@ -194,7 +196,7 @@ class Scene:
             if mon.kind == "reaction":
                 # reaction on the structure = λ f_ext − f_int at the constrained nodes
                 fint = model.reaction(mon.where, system.internal_force())
-                fext = model.reaction(mon.where, system.fext) * system.load_factor
+                fext = model.reaction(mon.where, system.fext_total)
                 names = ("Fx", "Fy", "Mz") if model.gdim == 2 else ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
                 for comp, val in zip(names, fext - fint):
                     values[f"{mon.name}_{comp}"] = -float(val)

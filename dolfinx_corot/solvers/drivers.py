@@ -123,7 +123,8 @@ class _Run:
 
 @dataclass(frozen=True)
 class LoadControl:
-    """Load factors ``load_factors`` (increasing), or ``steps`` equal steps up to ``final``.
+    """Load factors ``load_factors`` in turn (they may decrease, to unload), or ``steps`` equal
+    steps up to ``final``.
 
     max_cuts: successive halvings of a failing step before giving up;
     extrapolate: start each step from the secant extrapolation of the last
@@ -139,6 +140,7 @@ class LoadControl:
     newton: NewtonOptions = NewtonOptions()
 
     def targets(self) -> np.ndarray:
+        """The load factors to reach in turn (any order: they may decrease, to unload)."""
         if self.load_factors is not None:
             lf = np.asarray(self.load_factors, dtype=float)
         else:
@@ -157,11 +159,11 @@ class LoadControl:
         previous = None
         for target in self.targets():
             cuts = 0
-            while lam < target - 1e-14 * max(1.0, abs(target)):
+            while abs(target - lam) > 1e-14 * max(1.0, abs(target)):
                 trial = target if cuts == 0 else lam + (target - lam) / 2**cuts
                 cp = system.checkpoint()
                 started = run.begin()
-                if self.extrapolate and previous is not None and lam > previous[0]:
+                if self.extrapolate and previous is not None and lam != previous[0]:
                     # secant predictor along the last converged increment
                     system.extrapolate(previous[1], cp, (trial - lam) / (lam - previous[0]))
                 report = newton(system, trial, self.newton)
@@ -223,7 +225,10 @@ class ArcLength:
             raise NotImplementedError("arc-length with prescribed displacements is not supported; "
                                       "follow them with LoadControl (displacement control)")
         if system._fext_norm == 0.0:
-            raise ValueError("arc-length needs a reference load: the scene has no loads")
+            raise ValueError("arc-length needs a reference load: the scene has no loads proportional to λ")
+        if system.amplitude_loads:
+            raise NotImplementedError("arc-length follows proportional loading only; loads with an "
+                                      "amplitude are applied with LoadControl")
         opts = self.newton
         f = system.new_vector()
         system.reference_load(f)

@@ -1,0 +1,78 @@
+"""Hard cases of the load path: path independence, load-unload loops, amplitudes."""
+import numpy as np
+import pytest
+
+import dolfinx_corot as dc
+from dolfinx_corot.io.gmsh_models import polyline
+
+L, B, H, E = 2.0, 0.1, 0.05, 1e5
+
+
+@pytest.fixture(scope="module")
+def member():
+    return polyline([[0.0, 0.0, 0.0], [L, 0.0, 0.0]], 8, line_name="m", gdim=3)
+
+
+def _scene(tm, loads):
+    sc = dc.Scene()
+    m = sc.add_beam(tm, "m", section=dc.Rectangle(B, H), material=dc.Elastic(E, 0.3), orientation=(0, 1, 0))
+    sc.fix(m, "base")
+    for force, moment, amp in loads:
+        sc.load(m, "tip", force=force, moment=moment, amplitude=amp)
+    sc.monitor("tip", m, "tip")
+    return sc
+
+
+def test_dead_forces_in_either_order_reach_the_same_configuration(member):
+    """Conservative (dead) forces: F1 then F2, F2 then F1, or both together end in one state (1e-9)."""
+    EIz = E * B * H**3 / 12
+    F1 = np.array([0.0, 2.0 * EIz / L**2, 0.0])   # bends about z, tip rotation > 0.8 rad
+    F2 = np.array([0.0, 0.0, 1.5 * EIz / L**2])
+    first, second = dc.Amplitude([(0, 0), (1, 1)]), dc.Amplitude([(1, 0), (2, 1)])
+    both = dc.Amplitude([(0, 0), (2, 1)])
+    states = []
+    for a1, a2 in ((first, second), (second, first), (both, both)):
+        sc = _scene(member, [(F1, None, a1), (F2, None, a2)])
+        dc.solve(sc, dc.LoadControl(steps=16, final=2.0))
+        X, st = sc.model.nodes()
+        order = np.argsort(X[:, 0])
+        q = st[order, 3:] * np.sign(st[order, 3:4])  # q and −q are one rotation
+        states.append(np.c_[st[order, :3], q])
+    assert np.abs(states[0][:, :3]).max() > 0.3 * L  # a large-rotation state
+    for s in states[1:]:
+        np.testing.assert_allclose(s, states[0], atol=1e-9)
+
+
+def test_load_unload_loop_returns_to_the_start(member):
+    """Force and moment up to large rotations, then back to zero: displacements 0, rotations identity."""
+    EIz = E * B * H**3 / 12
+    sc = _scene(member, [(np.array([0.0, 1.0, 0.5]) * EIz / L**2, np.array([0.3, 0.0, 0.0]) * EIz / L, None)])
+    res = dc.solve(sc, dc.LoadControl(load_factors=np.r_[np.linspace(0.25, 2.0, 8), np.linspace(1.75, 0.0, 8)]))
+    lam = res.history.column("load_factor")
+    assert lam.max() == 2.0 and lam[-1] == 0.0
+    assert np.hypot(res.history.column("tip_uy"), res.history.column("tip_uz")).max() > 0.4 * L
+    _, st = sc.model.nodes()
+    assert np.abs(st[:, :3]).max() < 1e-10
+    np.testing.assert_allclose(np.abs(st[:, 3]), 1.0, atol=1e-12)
+
+
+def test_prescribed_motion_with_an_amplitude_unloads(member):
+    """Displacement control up and down with an amplitude: the reaction retraces its path."""
+    sc = dc.Scene()
+    m = sc.add_beam(member, "m", section=dc.Rectangle(B, H), material=dc.Elastic(E), orientation=(0, 1, 0))
+    sc.fix(m, "base")
+    sc.prescribe(m, "tip", uy=0.8 * L, amplitude=dc.Amplitude([(0, 0), (1, 1), (2, 0)]))
+    sc.monitor_reaction("jack", m, "tip")
+    res = dc.solve(sc, dc.LoadControl(steps=8, final=2.0))
+    fy = res.history.column("jack_Fy")
+    np.testing.assert_allclose(fy[:3], fy[6:3:-1], rtol=1e-8)  # up and down meet at the same points
+    assert abs(fy[-1]) < 1e-10 * abs(fy).max()
+
+
+def test_amplitude_validation_and_arc_length_refusal(member):
+    with pytest.raises(ValueError, match="load factors must increase"):
+        dc.Amplitude([(1, 0), (0, 1)])
+    sc = _scene(member, [(np.array([0.0, 1e-3, 0.0]), None, dc.Amplitude([(0, 0), (1, 1)])),
+                         (np.array([0.0, 0.0, 1e-3]), None, None)])
+    with pytest.raises(NotImplementedError, match="proportional loading only"):
+        dc.solve(sc, dc.ArcLength(max_steps=2))

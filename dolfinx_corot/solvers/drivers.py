@@ -153,11 +153,15 @@ class LoadControl:
 
     def run(self, run: _Run, restart: str | None = None) -> Result:
         system = run.system
+        start = 0
         if restart is not None:
-            run.load(restart, "LoadControl")
+            state, _ = run.load(restart, "LoadControl")
+            start = state["next_target"]
         lam = run.load_factor
         previous = None
-        for target in self.targets():
+        targets = self.targets()
+        for index in range(start, len(targets)):
+            target = targets[index]
             cuts = 0
             while abs(target - lam) > 1e-14 * max(1.0, abs(target)):
                 trial = target if cuts == 0 else lam + (target - lam) / 2**cuts
@@ -180,7 +184,8 @@ class LoadControl:
                 previous = (lam, cp)
                 lam = trial
                 run.record(lam, report, cuts, started)
-                run.save({"name": "LoadControl"})
+                reached = abs(target - lam) <= 1e-14 * max(1.0, abs(target))
+                run.save({"name": "LoadControl", "next_target": index + 1 if reached else index})
                 cuts = max(cuts - 1, 0)
         return run.result()
 

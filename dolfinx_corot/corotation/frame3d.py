@@ -57,21 +57,6 @@ def cross(a, b, out):
 
 
 @numba.njit(cache=True)
-def rotation_from_quaternion(q, R):
-    """R (3, 3) of the unit quaternion q (4,) = (w, x, y, z)."""
-    w, x, y, z = q[0], q[1], q[2], q[3]
-    R[0, 0] = 1.0 - 2.0 * (y * y + z * z)
-    R[0, 1] = 2.0 * (x * y - w * z)
-    R[0, 2] = 2.0 * (x * z + w * y)
-    R[1, 0] = 2.0 * (x * y + w * z)
-    R[1, 1] = 1.0 - 2.0 * (x * x + z * z)
-    R[1, 2] = 2.0 * (y * z - w * x)
-    R[2, 0] = 2.0 * (x * z - w * y)
-    R[2, 1] = 2.0 * (y * z + w * x)
-    R[2, 2] = 1.0 - 2.0 * (x * x + y * y)
-
-
-@numba.njit(cache=True)
 def exp_spin(w, R):
     """R = exp(spin(w)) (Rodrigues), complex-analytic; series below |w|² = 1e-6."""
     t2 = dot(w, w)

@@ -1,4 +1,4 @@
 """Element kernels: gather ► co-rotational frame ► local law ► scatter (numba)."""
-from . import line2d
+from . import beam3d, line2d
 
-__all__ = ["line2d"]
+__all__ = ["beam3d", "line2d"]

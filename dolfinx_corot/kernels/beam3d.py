@@ -20,10 +20,11 @@ from __future__ import annotations
 
 import numba
 import numpy as np
-from numba import types
 
 from ..corotation import frame3d
 from ..elements import beam3d as law
+from ..rotations import quat_to_matrix
+from .ufcx import signature
 
 NDOF = 12
 NSTATE = 7
@@ -53,10 +54,8 @@ def corotational(X1, X2, s1, s2, props, f, K):
     """Co-rotational element: s1, s2 nodal states (7,); fills f (12,) and K (12, 12)."""
     R0 = np.empty((3, 3))
     l0 = frame3d.initial_frame(X1, X2, props[law.VX:law.VZ + 1], R0)
-    R1 = np.empty((3, 3))
-    R2 = np.empty((3, 3))
-    frame3d.rotation_from_quaternion(s1[3:7], R1)
-    frame3d.rotation_from_quaternion(s2[3:7], R2)
+    R1 = quat_to_matrix(s1[3:7])
+    R2 = quat_to_matrix(s2[3:7])
     u1 = s1[:3].copy()
     u2 = s2[:3].copy()
     _force(X1, X2, u1, u2, R1, R2, R0, l0, props, f)
@@ -100,9 +99,7 @@ def corotational(X1, X2, s1, s2, props, f, K):
 @numba.njit(cache=True)
 def _rotation_vector(q, out):
     """Rotation vector of the unit quaternion q (angle below π)."""
-    R = np.empty((3, 3))
-    frame3d.rotation_from_quaternion(q, R)
-    frame3d.log_rotation(R, out)
+    frame3d.log_rotation(quat_to_matrix(q), out)
 
 
 @numba.njit(cache=True)
@@ -146,11 +143,6 @@ def evaluate_all(X, S, props, large_rotations, F, K):
         evaluate(X[e, 0], X[e, 1], S[e, 0], S[e, 1], props[e], large_rotations, F[e], K[e])
 
 
-_sig = types.void(types.CPointer(types.double), types.CPointer(types.double),
-                  types.CPointer(types.double), types.CPointer(types.double),
-                  types.CPointer(types.int32), types.CPointer(types.uint8))
-
-
 @numba.njit(cache=True, inline="always")
 def _tabulate(w_, c_, coords_, f, K):
     w = numba.carray(w_, (NCOEF,))
@@ -160,7 +152,7 @@ def _tabulate(w_, c_, coords_, f, K):
              w[2 * NSTATE:].copy(), c[0] != 0.0, f, K)
 
 
-@numba.cfunc(_sig, nopython=True, cache=True)
+@numba.cfunc(signature, nopython=True, cache=True)
 def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
     """Element internal-force vector (12,) for a DOLFINx linear form."""
     b = numba.carray(b_, (NDOF,))
@@ -174,10 +166,8 @@ def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
     if c[0] != 0.0:
         # the residual needs the force only: no complex-step columns
         l0 = frame3d.initial_frame(X[0].copy(), X[1].copy(), props[law.VX:law.VZ + 1], R0)
-        R1 = np.empty((3, 3))
-        R2 = np.empty((3, 3))
-        frame3d.rotation_from_quaternion(w[3:7].copy(), R1)
-        frame3d.rotation_from_quaternion(w[NSTATE + 3:NSTATE + 7].copy(), R2)
+        R1 = quat_to_matrix(w[3:7].copy())
+        R2 = quat_to_matrix(w[NSTATE + 3:NSTATE + 7].copy())
         _force(X[0].copy(), X[1].copy(), w[0:3].copy(), w[NSTATE:NSTATE + 3].copy(), R1, R2, R0, l0, props, f)
     else:
         _tabulate(w_, c_, coords_, f, K)
@@ -185,7 +175,7 @@ def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
         b[i] = f[i]
 
 
-@numba.cfunc(_sig, nopython=True, cache=True)
+@numba.cfunc(signature, nopython=True, cache=True)
 def matrix_kernel(A_, w_, c_, coords_, entity_local_index, permutation):
     """Element tangent (12, 12) for a DOLFINx bilinear form."""
     A = numba.carray(A_, (NDOF, NDOF))

@@ -19,10 +19,10 @@ from __future__ import annotations
 
 import numba
 import numpy as np
-from numba import types
 
 from ..corotation import frame2d
 from ..elements import line2d as law
+from .ufcx import signature
 
 NDOF = 6
 NCOEF = NDOF + law.NPROPS
@@ -91,11 +91,6 @@ def evaluate_all(X, D, props, large_rotations, F, K):
                    F[e], K[e], P, fbar, kbar)
 
 
-_sig = types.void(types.CPointer(types.double), types.CPointer(types.double),
-                  types.CPointer(types.double), types.CPointer(types.double),
-                  types.CPointer(types.int32), types.CPointer(types.uint8))
-
-
 @numba.njit(cache=True, inline="always")
 def _tabulate(w_, c_, coords_, f, K):
     w = numba.carray(w_, (NCOEF,))
@@ -104,7 +99,7 @@ def _tabulate(w_, c_, coords_, f, K):
     evaluate(X[0, 0], X[0, 1], X[1, 0], X[1, 1], w[:NDOF], w[NDOF:], c[0] != 0.0, f, K)
 
 
-@numba.cfunc(_sig, nopython=True, cache=True)
+@numba.cfunc(signature, nopython=True, cache=True)
 def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
     """Element internal-force vector (6,) for a DOLFINx linear form."""
     b = numba.carray(b_, (NDOF,))
@@ -112,7 +107,7 @@ def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
     _tabulate(w_, c_, coords_, b, K)
 
 
-@numba.cfunc(_sig, nopython=True, cache=True)
+@numba.cfunc(signature, nopython=True, cache=True)
 def matrix_kernel(A_, w_, c_, coords_, entity_local_index, permutation):
     """Element tangent (6, 6) for a DOLFINx bilinear form."""
     A = numba.carray(A_, (NDOF, NDOF))

@@ -158,13 +158,16 @@ class Scene:
         self._loads += 1
 
     def monitor(self, name: str, part: PartRef, where: str) -> None:
-        """Record the dofs of the single node of group ``where`` after every step."""
+        """Record the dofs of the (first) node of group ``where`` after every step, as
+        ``name_ux``, ``name_uy``, … In 2D ``name_rz`` is the total angle (it may exceed 2π);
+        in 3D ``name_rx..rz`` is the rotation vector of the nodal rotation (norm ≤ π)."""
         part.model.nodal_values(where)  # fails early for a missing group
         self.monitors.append(Monitor(name, part, where))
 
     def monitor_reaction(self, name: str, part: PartRef, where: str) -> None:
         """Record the force (sum over the nodes of ``where``) that the supports or prescribed
-        displacements there exert on the structure, after every step: name_Fx, name_Fy, name_Mz."""
+        displacements there exert on the structure, after every step: name_Fx, name_Fy, name_Mz
+        (2D) or name_Fx … name_Mz (3D)."""
         part.model.tmesh.vertices(where)  # fails early for a missing group
         self.monitors.append(Monitor(name, part, where, "reaction"))
 

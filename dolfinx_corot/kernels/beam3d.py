@@ -9,6 +9,8 @@ nodal rotation; element vector (12): (u₁, w₁, u₂, w₂) with spatial spins
   K[:, j] = Im f(d + i h e_j)/h with h = 1e-30, exact to rounding (Squire &
   Trapp 1998; Martins, Sturdza & Alonso 2003): a spin column perturbs the
   nodal rotation multiplicatively, R ← exp(i h e_k) R, as Newton updates it.
+  Only the six columns of node 1 are differentiated; those of node 2 follow
+  exactly from translation and rotation invariance of f.
 * :func:`linear`: K = B₀ᵀ K̄ B₀ in the initial frame, f = K d with the nodal
   rotation vectors log(R_i) (no co-rotational work).
 
@@ -70,11 +72,8 @@ def corotational(X1, X2, s1, s2, props, f, K):
     for j in range(12):
         node = j // 6
         k = j % 3
-        if 6 <= j < 9:
-            # f depends on u2 − u1 only: the columns of u2 are minus those of u1
-            for i in range(12):
-                K[i, j] = -K[i, j - 6]
-            continue
+        if j >= 6:
+            break
         a1, a2, Q1, Q2 = u1c.copy(), u2c.copy(), R1c, R2c
         if j % 6 < 3:
             if node == 0:
@@ -94,6 +93,30 @@ def corotational(X1, X2, s1, s2, props, f, K):
         _force(X1, X2, a1, a2, Q1, Q2, R0, l0, props, fc)
         for i in range(12):
             K[i, j] = fc[i].imag / H
+    # The remaining six columns follow from invariance, exactly:
+    # translation — f depends on u2 − u1, so K[:, u2] = −K[:, u1];
+    # rotation — a rigid rotation δu_i = e_k × x_i, δw_i = e_k turns every force and
+    # moment block b of f into e_k × f_b, so
+    # K[:, w2_k] = (e_k × f_b)_b − K[:, w1_k] − K[:, u1]·(e_k × (x1 − x2)).
+    for i in range(12):
+        for k in range(3):
+            K[i, 6 + k] = -K[i, k]
+    r = np.empty(3)
+    for k in range(3):
+        for m in range(3):
+            r[m] = X1[m] + u1[m] - X2[m] - u2[m]
+        ek_x_r = np.empty(3)
+        ek_x_r[0] = (k == 1) * r[2] - (k == 2) * r[1]
+        ek_x_r[1] = (k == 2) * r[0] - (k == 0) * r[2]
+        ek_x_r[2] = (k == 0) * r[1] - (k == 1) * r[0]
+        for b in range(4):
+            fb0, fb1, fb2 = f[3 * b], f[3 * b + 1], f[3 * b + 2]
+            g0 = (k == 1) * fb2 - (k == 2) * fb1
+            g1 = (k == 2) * fb0 - (k == 0) * fb2
+            g2 = (k == 0) * fb1 - (k == 1) * fb0
+            for m, gm in ((0, g0), (1, g1), (2, g2)):
+                i = 3 * b + m
+                K[i, 9 + k] = gm - K[i, 3 + k] - (K[i, 0] * ek_x_r[0] + K[i, 1] * ek_x_r[1] + K[i, 2] * ek_x_r[2])
 
 
 @numba.njit(cache=True)

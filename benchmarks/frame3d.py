@@ -12,6 +12,7 @@ Usage: python benchmarks/frame3d.py [--sizes 7 15 32]
 """
 import argparse
 import json
+import logging
 import os
 import time
 
@@ -23,6 +24,8 @@ from dolfinx_corot.assembly import System
 from dolfinx_corot.io import from_arrays, output_dir
 
 comm = MPI.COMM_WORLD
+logging.basicConfig(level=logging.WARNING)
+logging.getLogger("dolfinx_corot.solvers.drivers").setLevel(logging.INFO)
 
 
 def say(*a):

@@ -64,12 +64,14 @@ def bend(n):
 
 
 # %% [markdown]
-# ## Eight elements, ten load steps
+# ## Eight elements, ten load steps (fields for ParaView in `bend.xdmf`)
 
 # %%
 scene = bend(8)
 t0 = time.perf_counter()
-result = dc.solve(scene, dc.LoadControl(steps=10))
+# the deformed bend at every step, for ParaView (Warp By Vector on "displacement")
+with dc.io.FieldWriter(scene, os.path.join(out, "bend.xdmf")) as writer:
+    result = dc.solve(scene, dc.LoadControl(steps=10), on_step=writer)
 wall = time.perf_counter() - t0
 hist = result.history
 if comm.rank == 0:

@@ -76,3 +76,20 @@ def test_amplitude_validation_and_arc_length_refusal(member):
                          (np.array([0.0, 0.0, 1e-3]), None, None)])
     with pytest.raises(NotImplementedError, match="proportional loading only"):
         dc.solve(sc, dc.ArcLength(max_steps=2))
+
+
+def test_field_output_for_paraview(member, tmp_path):
+    """XDMF/HDF5 output: the stored displacement of the last step equals the monitored tip value."""
+    import h5py
+
+    sc = _scene(member, [(np.array([0.0, 1e-2, 0.0]), None, None)])
+    path = str(tmp_path / "member.xdmf")
+    with dc.io.FieldWriter(sc, path) as writer:
+        res = dc.solve(sc, dc.LoadControl(steps=3), on_step=writer)
+    with h5py.File(path.replace(".xdmf", ".h5"), "r") as f:
+        steps = sorted(f["Function/displacement"].keys(), key=lambda k: float(k.replace("_", ".")))
+        assert len(steps) == 3
+        u = f["Function/displacement"][steps[-1]][:]
+        x = f["Mesh/mesh/geometry"][:]
+    tip = np.argmax(x[:, 0])
+    assert abs(u[tip, 1] - res.history.column("tip_uy")[-1]) < 1e-14

@@ -1,7 +1,8 @@
 """Input and output: gmsh meshes with named groups, history files, plots."""
+from .fields import FieldWriter
 from .mesh import GroupNotFoundError, TaggedMesh, from_arrays, from_gmsh
 
-__all__ = ["GroupNotFoundError", "TaggedMesh", "from_arrays", "from_gmsh", "output_dir", "reference"]
+__all__ = ["FieldWriter", "GroupNotFoundError", "TaggedMesh", "from_arrays", "from_gmsh", "output_dir", "reference"]
 
 
 def output_dir(name: str) -> str:

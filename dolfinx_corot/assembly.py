@@ -50,17 +50,25 @@ def kernel_form(V: dolfinx.fem.FunctionSpace, kernel_address: int, rank: int,
 
 
 class Model(Protocol):
-    """What :class:`System` needs from the assembled part(s)."""
+    """What :class:`System` and the drivers need from the assembled part(s)."""
 
-    V: dolfinx.fem.FunctionSpace
+    V: dolfinx.fem.FunctionSpace                              # space of the Newton corrections
+    state: dolfinx.fem.Function                               # the configuration (kernels' coefficient)
+    symmetric_tangent: bool                                   # LDLᵀ allowed
+    has_prescribed_motion: bool
+    amplitudes: list                                          # distinct load amplitudes (None: ∝ λ)
 
     def forms(self) -> tuple[object, object]: ...            # (vector form, matrix form)
-    def dirichlet_bcs(self) -> list: ...                        # DOLFINx DirichletBCs (homogeneous)
-    def external_force(self, b: PETSc.Vec) -> None: ...         # fill the reference load vector
+    def dirichlet_bcs(self) -> list: ...                        # supports and prescribed motion
+    def set_load_factor(self, load_factor: float) -> None: ...  # prescribed values at λ
+    def external_force(self, b: PETSc.Vec, amplitude=None) -> None: ...  # unit loads of one amplitude
+    def displacement_vector(self) -> PETSc.Vec: ...             # x in the layout of V (constraints)
     def update(self, dx: PETSc.Vec) -> None: ...                # x ← x ⊕ dx
     def extrapolate(self, older: object, newer: object, factor: float) -> None: ...
     def checkpoint(self) -> object: ...
     def restore(self, cp: object) -> None: ...
+    def to_global(self, local: np.ndarray) -> np.ndarray | None: ...   # for checkpoint files
+    def from_global(self, values: np.ndarray) -> np.ndarray: ...
 
 
 @dataclass

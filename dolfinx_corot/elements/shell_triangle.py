@@ -1,0 +1,164 @@
+r"""Flat triangular shell in its element frame: membrane + drilling + DKT bending (linear).
+
+Local dofs per node, node-major: (u, v, w, θx, θy, θz); the element lies in
+the local x–y plane. Material: isotropic, plane stress, thickness t.
+
+* Membrane: constant-strain triangle, :math:`\mathbf K_m = tA\,\mathbf B_m^T\mathbf D_m\mathbf B_m`.
+* Drilling: :math:`U_d = \tfrac12\,\alpha G t A\sum_i(\theta_{zi} - \omega)^2`, with
+  :math:`\omega = \tfrac12(v_{,x} - u_{,y})` the in-plane rotation of the CST
+  (Hughes & Brezzi 1989 style penalty; rigid in-plane rotations cost nothing).
+* Bending: the discrete Kirchhoff triangle (Batoz, Bathe & Ho 1980), built as in
+  its original derivation: the slopes :math:`\boldsymbol\beta = (w_{,x}, w_{,y})` vary
+  quadratically; at the corners :math:`\beta_x = -\theta_y`, :math:`\beta_y = \theta_x`;
+  at mid-sides the tangential slope follows the cubic edge deflection,
+  :math:`\beta_s = \tfrac{3}{2l}(w_j - w_i) - \tfrac14(\beta_{si} + \beta_{sj})`, and the
+  normal slope is linear, :math:`\beta_n = \tfrac12(\beta_{ni} + \beta_{nj})`. Curvatures
+  :math:`\boldsymbol\kappa = (\beta_{x,x}, \beta_{y,y}, \beta_{x,y} + \beta_{y,x})`,
+  :math:`\mathbf K_b = \int\mathbf B_b^T\mathbf D_b\mathbf B_b\,dA` by a 3-point rule (exact).
+
+``props = (E, nu, t, alpha)``.
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+NPROPS = 4
+E_, NU, T, ALPHA = range(NPROPS)
+
+_GP = np.array([[1.0 / 6.0, 1.0 / 6.0], [2.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 2.0 / 3.0]])
+
+
+@numba.njit(cache=True)
+def _plane_stress(E, nu):
+    D = np.zeros((3, 3))
+    c = E / (1.0 - nu * nu)
+    D[0, 0] = c
+    D[1, 1] = c
+    D[0, 1] = c * nu
+    D[1, 0] = c * nu
+    D[2, 2] = c * (1.0 - nu) / 2.0
+    return D
+
+
+@numba.njit(cache=True)
+def membrane_B(xy):
+    """CST strain matrix (3, 6) for in-plane dofs (u1, v1, u2, v2, u3, v3) and twice the area."""
+    x1, y1, x2, y2, x3, y3 = xy[0, 0], xy[0, 1], xy[1, 0], xy[1, 1], xy[2, 0], xy[2, 1]
+    A2 = (x2 - x1) * (y3 - y1) - (x3 - x1) * (y2 - y1)
+    b = np.array([y2 - y3, y3 - y1, y1 - y2]) / A2
+    c = np.array([x3 - x2, x1 - x3, x2 - x1]) / A2
+    B = np.zeros((3, 6))
+    for i in range(3):
+        B[0, 2 * i] = b[i]
+        B[1, 2 * i + 1] = c[i]
+        B[2, 2 * i] = c[i]
+        B[2, 2 * i + 1] = b[i]
+    return B, A2
+
+
+@numba.njit(cache=True)
+def _dkt_midside(xy):
+    """T (6, 9): slopes (βx, βy) at the three mid-sides (edges 23, 31, 12) from the corner
+    dofs (w, θx, θy) of nodes 1–3."""
+    T = np.zeros((6, 9))
+    edges = ((1, 2), (2, 0), (0, 1))
+    for k in range(3):
+        i, j = edges[k]
+        dx = xy[j, 0] - xy[i, 0]
+        dy = xy[j, 1] - xy[i, 1]
+        l = np.sqrt(dx * dx + dy * dy)
+        c, s = dx / l, dy / l  # tangent s = (c, s), normal n = (s, −c)
+        # corner slopes: βx = −θy (col 3a+2), βy = θx (col 3a+1)
+        # β_s,a = c βx + s βy ; β_n,a = s βx − c βy
+        row_s = np.zeros(9)
+        row_n = np.zeros(9)
+        row_s[3 * j] += 1.5 / l
+        row_s[3 * i] -= 1.5 / l
+        for a in (i, j):
+            row_s[3 * a + 2] += -0.25 * c * -1.0
+            row_s[3 * a + 1] += -0.25 * s
+            row_n[3 * a + 2] += 0.5 * s * -1.0
+            row_n[3 * a + 1] += 0.5 * -c
+        # back to x, y: βx = c β_s + s β_n, βy = s β_s − c β_n
+        T[2 * k] = c * row_s + s * row_n
+        T[2 * k + 1] = s * row_s - c * row_n
+    return T
+
+
+@numba.njit(cache=True)
+def bending_B(xy, xi, eta):
+    """DKT curvature matrix (3, 9) at (ξ, η) for the dofs (w, θx, θy) of nodes 1–3."""
+    L1 = 1.0 - xi - eta
+    # derivatives of the 6 quadratic shape functions w.r.t. ξ and η
+    dN = np.zeros((2, 6))
+    dN[0, 0] = -(4.0 * L1 - 1.0)
+    dN[1, 0] = -(4.0 * L1 - 1.0)
+    dN[0, 1] = 4.0 * xi - 1.0
+    dN[1, 2] = 4.0 * eta - 1.0
+    dN[0, 3] = 4.0 * eta        # mid-side of edge 23: 4 L2 L3
+    dN[1, 3] = 4.0 * xi
+    dN[0, 4] = -4.0 * eta       # edge 31: 4 L3 L1
+    dN[1, 4] = 4.0 * (L1 - eta)
+    dN[0, 5] = 4.0 * (L1 - xi)  # edge 12: 4 L1 L2
+    dN[1, 5] = -4.0 * xi
+    J = np.empty((2, 2))
+    J[0, 0] = xy[1, 0] - xy[0, 0]
+    J[0, 1] = xy[1, 1] - xy[0, 1]
+    J[1, 0] = xy[2, 0] - xy[0, 0]
+    J[1, 1] = xy[2, 1] - xy[0, 1]
+    Ji = np.linalg.inv(J)
+    dNx = Ji @ dN  # (2, 6): ∂N/∂x, ∂N/∂y
+    # slopes at the 6 nodes from the 9 corner dofs
+    S = np.zeros((12, 9))  # rows: βx1, βy1, βx2, βy2, βx3, βy3, then mid-sides
+    for a in range(3):
+        S[2 * a, 3 * a + 2] = -1.0
+        S[2 * a + 1, 3 * a + 1] = 1.0
+    S[6:, :] = _dkt_midside(xy)
+    B = np.zeros((3, 9))
+    for n in range(6):
+        for col in range(9):
+            bx = S[2 * n, col]
+            by = S[2 * n + 1, col]
+            B[0, col] += dNx[0, n] * bx
+            B[1, col] += dNx[1, n] * by
+            B[2, col] += dNx[1, n] * bx + dNx[0, n] * by
+    return B
+
+
+@numba.njit(cache=True)
+def local_stiffness(xy, props, K):
+    """Fill K (18, 18), the linear stiffness of the flat triangle with local node coordinates xy (3, 2)."""
+    E, nu, t, alpha = props[E_], props[NU], props[T], props[ALPHA]
+    K[:, :] = 0.0
+    Bm, A2 = membrane_B(xy)
+    A = 0.5 * A2
+    Dm = _plane_stress(E, nu) * t
+    Km = A * Bm.T @ Dm @ Bm
+    mem = np.array([0, 1, 6, 7, 12, 13])
+    for a in range(6):
+        for b in range(6):
+            K[mem[a], mem[b]] += Km[a, b]
+    # drilling: (θz_i − ω), ω = ½(v,x − u,y) from the CST
+    G = E / (2.0 * (1.0 + nu))
+    kd = alpha * G * t * A
+    om = np.zeros(18)
+    for a in range(3):
+        om[6 * a] = -0.5 * Bm[1, 2 * a + 1]   # −½ ∂N/∂y on u
+        om[6 * a + 1] = 0.5 * Bm[0, 2 * a]    # ½ ∂N/∂x on v
+    for i in range(3):
+        g = -om.copy()
+        g[6 * i + 5] += 1.0
+        for a in range(18):
+            for b in range(18):
+                K[a, b] += kd * g[a] * g[b]
+    # bending
+    Db = _plane_stress(E, nu) * (t * t * t / 12.0)
+    bend = np.array([2, 3, 4, 8, 9, 10, 14, 15, 16])
+    Kb = np.zeros((9, 9))
+    for q in range(3):
+        Bb = bending_B(xy, _GP[q, 0], _GP[q, 1])
+        Kb += (A / 3.0) * Bb.T @ Db @ Bb
+    for a in range(9):
+        for b in range(9):
+            K[bend[a], bend[b]] += Kb[a, b]

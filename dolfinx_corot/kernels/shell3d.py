@@ -1,0 +1,162 @@
+r"""Three-node flat shells in space: gather ► frame ► law ► scatter.
+
+Nodal state (7 per node): displacement (3) and unit quaternion (4); element
+vector (18): (u_a, w_a) per node with spatial spins w.
+
+* :func:`corotational`: f = Bᵀ K̄ d̄ with the frame of
+  :mod:`dolfinx_corot.corotation.frame_triangle` and the linear flat
+  triangle of :mod:`dolfinx_corot.elements.shell_triangle` (element-independent
+  co-rotational formulation); consistent tangent K = ∂f/∂d by complex-step
+  differentiation (h = 1e-30), a spin column perturbing the nodal rotation
+  multiplicatively.
+* :func:`linear`: K = B₀ᵀ K̄ B₀ in the initial frame, f = K d with nodal
+  rotation vectors (no co-rotational work).
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from ..corotation import frame_triangle as frame
+from ..corotation.frame3d import _mat3, exp_spin, log_rotation
+from ..elements import shell_triangle as law
+from ..rotations import quat_to_matrix
+from .ufcx import signature
+
+NDOF = 18
+NSTATE = 7
+NCOEF = 3 * NSTATE + law.NPROPS
+H = 1e-30
+
+
+@numba.njit(cache=True)
+def _force(X, u, R, R0, xbar0, Kbar, f):
+    dt = u.dtype
+    dbar = np.empty(18, dtype=dt)
+    B = np.empty((18, 18), dtype=dt)
+    frame.basic(X, u, R, R0, xbar0, dbar, B)
+    fbar = np.empty(18, dtype=dt)
+    for i in range(18):
+        acc = Kbar[i, 0] * dbar[0]
+        for j in range(1, 18):
+            acc += Kbar[i, j] * dbar[j]
+        fbar[i] = acc
+    for i in range(18):
+        acc = B[0, i] * fbar[0]
+        for r in range(1, 18):
+            acc += B[r, i] * fbar[r]
+        f[i] = acc
+
+
+@numba.njit(cache=True)
+def _setup(X, props):
+    R0 = np.empty((3, 3))
+    xbar0 = np.empty((3, 3))
+    frame.initial(X, R0, xbar0)
+    Kbar = np.empty((18, 18))
+    law.local_stiffness(np.ascontiguousarray(xbar0[:, :2]), props, Kbar)
+    return R0, xbar0, Kbar
+
+
+@numba.njit(cache=True)
+def corotational(X, S, props, f, K):
+    """X (3, 3) initial nodes, S (3, 7) nodal states → f (18,), K (18, 18)."""
+    R0, xbar0, Kbar = _setup(X, props)
+    u = np.empty((3, 3))
+    R = np.empty((3, 3, 3))
+    for a in range(3):
+        u[a] = S[a, :3]
+        R[a] = quat_to_matrix(S[a, 3:7].copy())
+    _force(X, u, R, R0, xbar0, Kbar, f)
+    uc = u.astype(np.complex128)
+    Rc = R.astype(np.complex128)
+    fc = np.empty(18, dtype=np.complex128)
+    E = np.empty((3, 3), dtype=np.complex128)
+    w = np.zeros(3, dtype=np.complex128)
+    Q = np.empty((3, 3), dtype=np.complex128)
+    for j in range(18):
+        a, c = divmod(j, 6)
+        up = uc.copy()
+        Rp = Rc.copy()
+        if c < 3:
+            up[a, c] += 1j * H
+        else:
+            w[:] = 0.0
+            w[c - 3] = 1j * H
+            exp_spin(w, E)
+            _mat3(E, Rc[a], Q)
+            Rp[a] = Q
+        _force(X, up, Rp, R0, xbar0, Kbar, fc)
+        for i in range(18):
+            K[i, j] = fc[i].imag / H
+
+
+@numba.njit(cache=True)
+def linear(X, S, props, f, K):
+    """Geometrically linear flat shell in the initial frame: K = B₀ᵀ K̄ B₀, f = K d."""
+    R0, xbar0, Kbar = _setup(X, props)
+    u = np.zeros((3, 3))
+    R = np.empty((3, 3, 3))
+    for a in range(3):
+        R[a] = np.eye(3)
+    dbar = np.empty(18)
+    B = np.empty((18, 18))
+    frame.basic(X, u, R, R0, xbar0, dbar, B)
+    K[:, :] = B.T @ Kbar @ B
+    d = np.empty(18)
+    r = np.empty(3)
+    for a in range(3):
+        d[6 * a:6 * a + 3] = S[a, :3]
+        log_rotation(quat_to_matrix(S[a, 3:7].copy()), r)
+        d[6 * a + 3:6 * a + 6] = r
+    f[:] = K @ d
+
+
+@numba.njit(cache=True)
+def evaluate(X, S, props, large_rotations, f, K):
+    if large_rotations:
+        corotational(X, S, props, f, K)
+    else:
+        linear(X, S, props, f, K)
+
+
+@numba.njit(cache=True, inline="always")
+def _tabulate(w_, c_, coords_, f, K):
+    w = numba.carray(w_, (NCOEF,))
+    c = numba.carray(c_, (1,))
+    X = numba.carray(coords_, (3, 3)).copy()
+    S = w[:3 * NSTATE].copy().reshape(3, NSTATE)
+    evaluate(X, S, w[3 * NSTATE:].copy(), c[0] != 0.0, f, K)
+
+
+@numba.cfunc(signature, nopython=True, cache=True)
+def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
+    """Element internal-force vector (18,) for a DOLFINx linear form."""
+    b = numba.carray(b_, (NDOF,))
+    w = numba.carray(w_, (NCOEF,))
+    c = numba.carray(c_, (1,))
+    f = np.empty(NDOF)
+    if c[0] != 0.0:
+        X = numba.carray(coords_, (3, 3)).copy()
+        R0, xbar0, Kbar = _setup(X, w[3 * NSTATE:].copy())
+        u = np.empty((3, 3))
+        R = np.empty((3, 3, 3))
+        for a in range(3):
+            u[a] = w[NSTATE * a:NSTATE * a + 3]
+            R[a] = quat_to_matrix(w[NSTATE * a + 3:NSTATE * a + 7].copy())
+        _force(X, u, R, R0, xbar0, Kbar, f)
+    else:
+        K = np.empty((NDOF, NDOF))
+        _tabulate(w_, c_, coords_, f, K)
+    for i in range(NDOF):
+        b[i] = f[i]
+
+
+@numba.cfunc(signature, nopython=True, cache=True)
+def matrix_kernel(A_, w_, c_, coords_, entity_local_index, permutation):
+    """Element tangent (18, 18) for a DOLFINx bilinear form."""
+    A = numba.carray(A_, (NDOF, NDOF))
+    f = np.empty(NDOF)
+    K = np.empty((NDOF, NDOF))
+    _tabulate(w_, c_, coords_, f, K)
+    A[:, :] = K

@@ -26,9 +26,11 @@ import dolfinx.la
 from . import assembly, rotations
 from .elements import beam3d as law3d
 from .elements import line2d as law2d
+from .elements import shell_triangle as shell_law
 from .io.mesh import TaggedMesh
 from .kernels import beam3d as kernels3d
 from .kernels import line2d as kernels2d
+from .kernels import shell3d as kernels_shell
 
 
 @dataclass(frozen=True)
@@ -41,8 +43,9 @@ class PartRef:
 
 
 class LineFrame:
-    """What 2D and 3D frames share: cells, properties, supports, loads, forms, read-out."""
+    """What 2D and 3D frames and shells share: cells, properties, supports, loads, forms, read-out."""
 
+    tdim = 1
     gdim: int
     dof_names: tuple[str, ...]
     translations: int           # number of translational dofs per node
@@ -52,8 +55,8 @@ class LineFrame:
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
         mesh = tmesh.mesh
-        if mesh.topology.dim != 1 or mesh.geometry.dim != self.gdim:
-            raise ValueError(f"a {self.gdim}D frame needs a mesh of lines (tdim 1, gdim {self.gdim}); got "
+        if mesh.topology.dim != self.tdim or mesh.geometry.dim != self.gdim:
+            raise ValueError(f"{type(self).__name__} needs a mesh of tdim {self.tdim} in gdim {self.gdim}; got "
                              f"tdim {mesh.topology.dim}, gdim {mesh.geometry.dim}: read the gmsh model "
                              f"with from_gmsh(model, gdim={self.gdim})")
         self.tmesh = tmesh
@@ -63,7 +66,7 @@ class LineFrame:
         Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=self.nprops)
         self.props = dolfinx.fem.Function(Q, name="section")
         self._prop_blocks = Q.dofmap.list.array  # DG0: one block per cell
-        cmap = mesh.topology.index_map(1)
+        cmap = mesh.topology.index_map(self.tdim)
         self._owner_of_cell = np.full(cmap.size_local + cmap.num_ghosts, "", dtype=object)
         self._bending = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
         self.parts: list[PartRef] = []
@@ -136,7 +139,7 @@ class LineFrame:
 
     def forms(self):
         if self._forms is None:
-            cmap = self.tmesh.mesh.topology.index_map(1)
+            cmap = self.tmesh.mesh.topology.index_map(self.tdim)
             owned = np.flatnonzero(self._owner_of_cell[: cmap.size_local] != "").astype(np.int32)
             all_owned = self.V.mesh.comm.allreduce(len(owned) == cmap.size_local)
             cells = None if all_owned else owned
@@ -177,8 +180,8 @@ class LineFrame:
     def _rotation_free_vertices(self) -> np.ndarray:
         """Vertices touched by no bending element: their rotation has no stiffness and is fixed."""
         mesh = self.tmesh.mesh
-        mesh.topology.create_connectivity(0, 1)
-        v2c = mesh.topology.connectivity(0, 1)
+        mesh.topology.create_connectivity(0, self.tdim)
+        v2c = mesh.topology.connectivity(0, self.tdim)
         vmap = mesh.topology.index_map(0)
         nv = vmap.size_local + vmap.num_ghosts
         counts = np.add.reduceat(self._bending[v2c.array].astype(np.int32), v2c.offsets[:-1][:nv])
@@ -373,3 +376,50 @@ class Frame3D(LineFrame):
     @staticmethod
     def _dof_values(s: np.ndarray) -> np.ndarray:
         return np.concatenate([s[:3], rotations.rotvec_from_quat(s[3:7].copy())])
+
+
+class Shell3D(LineFrame):
+    """Flat co-rotational shell triangles on a triangle mesh in space; dofs (ux, uy, uz, rx, ry, rz)
+    per node, rotations multiplicative as in :class:`Frame3D`."""
+
+    tdim = 2
+    gdim = 3
+    dof_names = Frame3D.dof_names
+    translations = 3
+    state_size = kernels3d.NSTATE
+    nprops = shell_law.NPROPS
+    kernels = kernels_shell
+    symmetric_tangent = False
+    update = Frame3D.update
+    extrapolate = Frame3D.extrapolate
+    displacement_vector = Frame3D.displacement_vector
+    _dof_values = staticmethod(Frame3D._dof_values)
+
+    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
+        if tmesh.mesh.topology.cell_name() != "triangle":
+            raise NotImplementedError(f"shells are triangles; the mesh has {tmesh.mesh.topology.cell_name()} "
+                                      "cells (set Mesh.RecombineAll = 0 in gmsh)")
+        super().__init__(tmesh, large_rotations)
+        S = dolfinx.fem.VectorFunctionSpace(tmesh.mesh, ("Lagrange", 1), dim=kernels3d.NSTATE)
+        self.state = dolfinx.fem.Function(S, name="state")
+        self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, 3] = 1.0
+        self._disp = dolfinx.fem.Function(self.V, name="displacement")
+
+    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float):
+        label = f"shell '{where}'"
+        if not (thickness > 0.0 and np.isfinite(thickness)):
+            raise ValueError(f"{label}: thickness = {thickness} must be positive")
+        if not drilling > 0.0:
+            raise ValueError(f"{label}: the drilling factor {drilling} must be positive")
+        return self.add_elements(where, np.array([E, nu, thickness, drilling]), True, "shell")
+
+    def _check_geometry(self, cells, label, props):
+        x = self.tmesh.mesh.geometry.x
+        g = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 3)[cells]
+        area = 0.5 * np.linalg.norm(np.cross(x[g[:, 1]] - x[g[:, 0]], x[g[:, 2]] - x[g[:, 0]]), axis=1)
+        scale = max(float(np.ptp(x, axis=0).max()) if len(x) else 1.0, 1e-300)
+        bad = np.flatnonzero(area <= 1e-10 * scale**2)
+        if len(bad):
+            p = x[g[bad[0], 0]]
+            raise ValueError(f"{label}: {len(bad)} triangle(s) of zero area, the first at "
+                             f"({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g})")

@@ -23,7 +23,7 @@ import numpy as np
 
 from .io.mesh import TaggedMesh
 from .materials import Elastic
-from .parts import Frame2D, Frame3D, LineFrame, PartRef
+from .parts import Frame2D, Frame3D, LineFrame, PartRef, Shell3D
 from .sections import Section
 
 KINEMATICS = ("bernoulli", "timoshenko")
@@ -60,7 +60,10 @@ class Scene:
             if self._models:
                 raise NotImplementedError("all structural parts must share one mesh (parts on different "
                                           "meshes are coupled in a later release); put every group in one gmsh model")
-            frame = Frame3D if tmesh.mesh.geometry.dim == 3 else Frame2D
+            if tmesh.mesh.topology.dim == 2:
+                frame = Shell3D
+            else:
+                frame = Frame3D if tmesh.mesh.geometry.dim == 3 else Frame2D
             self._models[key] = frame(tmesh, self.large_rotations)
         return self._models[key]
 
@@ -88,6 +91,17 @@ class Scene:
         return model.add_beam(where, {"EA": E * section.A, "GJ": G * section.torsion_constant,
                                       "EIy": E * section.second_moment_y, "EIz": E * section.I,
                                       "GAy": GAs, "GAz": GAs}, orientation, 0.0, "beam")
+
+    def add_shell(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float, material: Elastic,
+                  drilling: float = 1e-2) -> PartRef:
+        """Flat co-rotational shell triangles (membrane + drilling + DKT bending) on group ``where``
+        of a triangle mesh in space. drilling: factor α of the drilling penalty α·G·t·A."""
+        if not isinstance(material, Elastic):
+            raise TypeError(f"shell '{where}': material must be dc.Elastic, got {type(material).__name__}")
+        model = self._model(tmesh)
+        if not isinstance(model, Shell3D):
+            raise ValueError(f"shell '{where}': shells need a triangle mesh in 3D (from_gmsh(model, gdim=3))")
+        return model.add_shell(where, material.E, material.nu, float(thickness), float(drilling))
 
     def add_truss(self, tmesh: TaggedMesh, where: str | None = None, *, area: float, material: Elastic,
                   prestress_force: float = 0.0) -> PartRef:

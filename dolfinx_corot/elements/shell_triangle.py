@@ -107,8 +107,11 @@ def bending_B(xy, xi, eta):
     J[0, 1] = xy[1, 1] - xy[0, 1]
     J[1, 0] = xy[2, 0] - xy[0, 0]
     J[1, 1] = xy[2, 1] - xy[0, 1]
-    Ji = np.linalg.inv(J)
-    dNx = Ji @ dN  # (2, 6): ∂N/∂x, ∂N/∂y
+    det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+    dNx = np.empty((2, 6))  # ∂N/∂x, ∂N/∂y = J⁻¹ (∂N/∂ξ, ∂N/∂η)
+    for n in range(6):
+        dNx[0, n] = (J[1, 1] * dN[0, n] - J[0, 1] * dN[1, n]) / det
+        dNx[1, n] = (-J[1, 0] * dN[0, n] + J[0, 0] * dN[1, n]) / det
     # slopes at the 6 nodes from the 9 corner dofs
     S = np.zeros((12, 9))  # rows: βx1, βy1, βx2, βy2, βx3, βy3, then mid-sides
     for a in range(3):
@@ -127,6 +130,19 @@ def bending_B(xy, xi, eta):
 
 
 @numba.njit(cache=True)
+def _add_btdb(B, D, w, dofs, K):
+    """K[dofs, dofs] += w Bᵀ D B for a strain matrix B (3, n) (explicit loops: tiny blocks)."""
+    n = B.shape[1]
+    DB = np.empty((3, n))
+    for i in range(3):
+        for j in range(n):
+            DB[i, j] = D[i, 0] * B[0, j] + D[i, 1] * B[1, j] + D[i, 2] * B[2, j]
+    for a in range(n):
+        for b in range(n):
+            K[dofs[a], dofs[b]] += w * (B[0, a] * DB[0, b] + B[1, a] * DB[1, b] + B[2, a] * DB[2, b])
+
+
+@numba.njit(cache=True)
 def local_stiffness(xy, props, K):
     """Fill K (18, 18), the linear stiffness of the flat triangle with local node coordinates xy (3, 2)."""
     E, nu, t, alpha = props[E_], props[NU], props[T], props[ALPHA]
@@ -134,11 +150,7 @@ def local_stiffness(xy, props, K):
     Bm, A2 = membrane_B(xy)
     A = 0.5 * A2
     Dm = _plane_stress(E, nu) * t
-    Km = A * Bm.T @ Dm @ Bm
-    mem = np.array([0, 1, 6, 7, 12, 13])
-    for a in range(6):
-        for b in range(6):
-            K[mem[a], mem[b]] += Km[a, b]
+    _add_btdb(Bm, Dm, A, np.array([0, 1, 6, 7, 12, 13]), K)
     # drilling: (θz_i − ω), ω = ½(v,x − u,y) from the CST
     G = E / (2.0 * (1.0 + nu))
     kd = alpha * G * t * A
@@ -155,10 +167,5 @@ def local_stiffness(xy, props, K):
     # bending
     Db = _plane_stress(E, nu) * (t * t * t / 12.0)
     bend = np.array([2, 3, 4, 8, 9, 10, 14, 15, 16])
-    Kb = np.zeros((9, 9))
     for q in range(3):
-        Bb = bending_B(xy, _GP[q, 0], _GP[q, 1])
-        Kb += (A / 3.0) * Bb.T @ Db @ Bb
-    for a in range(9):
-        for b in range(9):
-            K[bend[a], bend[b]] += Kb[a, b]
+        _add_btdb(bending_B(xy, _GP[q, 0], _GP[q, 1]), Db, A / 3.0, bend, K)

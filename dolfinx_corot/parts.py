@@ -411,7 +411,12 @@ class Shell3D(LineFrame):
             raise ValueError(f"{label}: thickness = {thickness} must be positive")
         if not drilling > 0.0:
             raise ValueError(f"{label}: the drilling factor {drilling} must be positive")
-        return self.add_elements(where, np.array([E, nu, thickness, drilling]), True, "shell")
+        return self.add_elements(where, np.array([E, nu, thickness, drilling, 1.0]), True, "shell")
+
+    def add_membrane(self, where, E: float, nu: float, thickness: float):
+        if not (thickness > 0.0 and np.isfinite(thickness)):
+            raise ValueError(f"membrane '{where}': thickness = {thickness} must be positive")
+        return self.add_elements(where, np.array([E, nu, thickness, 0.0, 0.0]), False, "membrane")
 
     def _check_geometry(self, cells, label, props):
         x = self.tmesh.mesh.geometry.x

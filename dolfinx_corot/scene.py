@@ -103,6 +103,17 @@ class Scene:
             raise ValueError(f"shell '{where}': shells need a triangle mesh in 3D (from_gmsh(model, gdim=3))")
         return model.add_shell(where, material.E, material.nu, float(thickness), float(drilling))
 
+    def add_membrane(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float,
+                     material: Elastic) -> PartRef:
+        """Co-rotational membrane triangles (in-plane stiffness only) on group ``where`` of a
+        triangle mesh in space; nodes carried by membranes alone have their rotations fixed."""
+        if not isinstance(material, Elastic):
+            raise TypeError(f"membrane '{where}': material must be dc.Elastic, got {type(material).__name__}")
+        model = self._model(tmesh)
+        if not isinstance(model, Shell3D):
+            raise ValueError(f"membrane '{where}': membranes need a triangle mesh in 3D (from_gmsh(model, gdim=3))")
+        return model.add_membrane(where, material.E, material.nu, float(thickness))
+
     def add_truss(self, tmesh: TaggedMesh, where: str | None = None, *, area: float, material: Elastic,
                   prestress_force: float = 0.0) -> PartRef:
         """Bar (truss, anchor) elements on group ``where``; axial force only.

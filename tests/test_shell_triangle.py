@@ -5,7 +5,7 @@ from scipy.spatial import Delaunay
 
 from dolfinx_corot.elements import shell_triangle as st
 
-PROPS = np.array([2.1e5, 0.3, 0.1, 1e-2])
+PROPS = np.array([2.1e5, 0.3, 0.1, 1e-2, 1.0])
 
 
 def _K(xy, props=PROPS):
@@ -104,7 +104,7 @@ def test_cantilever_strip_tip_deflection():
     for i in range(nx):
         a0, a1, b0, b1 = 2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3
         tri += [(a0, b0, b1), (a0, b1, a1)]
-    props = np.array([1e4, 0.0, 0.1, 1e-2])
+    props = np.array([1e4, 0.0, 0.1, 1e-2, 1.0])
     n = len(pts)
     K = np.zeros((6 * n, 6 * n))
     for t in np.array(tri):

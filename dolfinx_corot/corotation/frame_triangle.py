@@ -65,11 +65,12 @@ def initial(X, R0, xbar0):
 
 
 @numba.njit(cache=True)
-def basic(X, u, R, R0, xbar0, dbar, B):
+def basic(X, u, R, R0, xbar0, dbar, B, rotations=True):
     """Deformational dofs dbar (18,) = (ū_a, θ̄_a) per node and B = ∂d̄/∂d (18, 18).
 
     X (3, 3) initial and u (3, 3) displacements of the nodes; R (3, 3, 3) nodal
-    rotations; R0, xbar0 from :func:`initial`.
+    rotations; R0, xbar0 from :func:`initial`. rotations=False (membranes):
+    θ̄ = 0 and its rows of B are zero; the nodal rotations are not used.
     """
     dt = u.dtype
     x = np.empty((3, 3), dtype=dt)
@@ -92,12 +93,15 @@ def basic(X, u, R, R0, xbar0, dbar, B):
     th = np.empty((3, 3), dtype=dt)
     Ra = np.empty((3, 3), dtype=dt)
     for a in range(3):
-        for i in range(3):
-            for j in range(3):
-                Ra[i, j] = R[a, i, j]
-        _mat3_tn(Rr, Ra, T)
-        _mat3(T, R0c, Rb)
-        log_rotation(Rb, th[a])
+        if rotations:
+            for i in range(3):
+                for j in range(3):
+                    Ra[i, j] = R[a, i, j]
+            _mat3_tn(Rr, Ra, T)
+            _mat3(T, R0c, Rb)
+            log_rotation(Rb, th[a])
+        else:
+            th[a, :] = 0.0
         for k in range(3):
             dbar[6 * a + k] = xbar[a, k] - xbar0[a, k]
             dbar[6 * a + 3 + k] = th[a, k]
@@ -130,6 +134,8 @@ def basic(X, u, R, R0, xbar0, dbar, B):
             Bl[6 * a + 1, col] += xa[2] * o0 - xa[0] * o2
             Bl[6 * a + 2, col] += xa[0] * o1 - xa[1] * o0
         # δθ̄_a = T⁻¹(θ̄_a)(δw_a − ω)
+        if not rotations:
+            continue
         tangent_inverse(th[a], Ti)
         for r in range(3):
             for col in range(18):

@@ -16,15 +16,16 @@ the local x–y plane. Material: isotropic, plane stress, thickness t.
   :math:`\boldsymbol\kappa = (\beta_{x,x}, \beta_{y,y}, \beta_{x,y} + \beta_{y,x})`,
   :math:`\mathbf K_b = \int\mathbf B_b^T\mathbf D_b\mathbf B_b\,dA` by a 3-point rule (exact).
 
-``props = (E, nu, t, alpha)``.
+``props = (E, nu, t, alpha, bending)``; ``bending = 0`` gives a membrane:
+the constant-strain triangle alone, no drilling and no bending stiffness.
 """
 from __future__ import annotations
 
 import numba
 import numpy as np
 
-NPROPS = 4
-E_, NU, T, ALPHA = range(NPROPS)
+NPROPS = 5
+E_, NU, T, ALPHA, BENDING = range(NPROPS)
 
 _GP = np.array([[1.0 / 6.0, 1.0 / 6.0], [2.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 2.0 / 3.0]])
 
@@ -151,6 +152,8 @@ def local_stiffness(xy, props, K):
     A = 0.5 * A2
     Dm = _plane_stress(E, nu) * t
     _add_btdb(Bm, Dm, A, np.array([0, 1, 6, 7, 12, 13]), K)
+    if props[BENDING] == 0.0:
+        return
     # drilling: (θz_i − ω), ω = ½(v,x − u,y) from the CST
     G = E / (2.0 * (1.0 + nu))
     kd = alpha * G * t * A

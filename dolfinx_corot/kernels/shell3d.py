@@ -31,11 +31,11 @@ H = 1e-30
 
 
 @numba.njit(cache=True)
-def _force(X, u, R, R0, xbar0, Kbar, f):
+def _force(X, u, R, R0, xbar0, Kbar, f, rotations):
     dt = u.dtype
     dbar = np.empty(18, dtype=dt)
     B = np.empty((18, 18), dtype=dt)
-    frame.basic(X, u, R, R0, xbar0, dbar, B)
+    frame.basic(X, u, R, R0, xbar0, dbar, B, rotations)
     fbar = np.empty(18, dtype=dt)
     for i in range(18):
         acc = Kbar[i, 0] * dbar[0]
@@ -68,7 +68,8 @@ def corotational(X, S, props, f, K):
     for a in range(3):
         u[a] = S[a, :3]
         R[a] = quat_to_matrix(S[a, 3:7].copy())
-    _force(X, u, R, R0, xbar0, Kbar, f)
+    rotations = props[law.BENDING] != 0.0
+    _force(X, u, R, R0, xbar0, Kbar, f, rotations)
     uc = u.astype(np.complex128)
     Rc = R.astype(np.complex128)
     fc = np.empty(18, dtype=np.complex128)
@@ -87,7 +88,7 @@ def corotational(X, S, props, f, K):
             exp_spin(w, E)
             _mat3(E, Rc[a], Q)
             Rp[a] = Q
-        _force(X, up, Rp, R0, xbar0, Kbar, fc)
+        _force(X, up, Rp, R0, xbar0, Kbar, fc, rotations)
         for i in range(18):
             K[i, j] = fc[i].imag / H
     # translation invariance: Σ_a K[:, u_a] = 0
@@ -130,7 +131,7 @@ def linear(X, S, props, f, K):
         R[a] = np.eye(3)
     dbar = np.empty(18)
     B = np.empty((18, 18))
-    frame.basic(X, u, R, R0, xbar0, dbar, B)
+    frame.basic(X, u, R, R0, xbar0, dbar, B, props[law.BENDING] != 0.0)
     K[:, :] = B.T @ Kbar @ B
     d = np.empty(18)
     r = np.empty(3)
@@ -173,7 +174,7 @@ def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
         for a in range(3):
             u[a] = w[NSTATE * a:NSTATE * a + 3]
             R[a] = quat_to_matrix(w[NSTATE * a + 3:NSTATE * a + 7].copy())
-        _force(X, u, R, R0, xbar0, Kbar, f)
+        _force(X, u, R, R0, xbar0, Kbar, f, w[3 * NSTATE + law.BENDING] != 0.0)
     else:
         K = np.empty((NDOF, NDOF))
         _tabulate(w_, c_, coords_, f, K)

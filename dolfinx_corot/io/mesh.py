@@ -150,11 +150,11 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0) 
 def from_arrays(points: np.ndarray, cells: np.ndarray, cell_name: str = "all",
                 point_groups: dict[str, np.ndarray] | None = None,
                 comm: MPI.Comm = MPI.COMM_WORLD) -> TaggedMesh:
-    """A :class:`TaggedMesh` of line elements built from arrays (frames and lattices made in code).
+    """A :class:`TaggedMesh` built from arrays (frames, lattices and surfaces made in code).
 
-    points: (n, gdim) node coordinates; cells: (m, 2) node indices; all cells
-    form the group ``cell_name``; point_groups: name → node indices. The
-    arrays are read on rank 0 and distributed.
+    points: (n, gdim) node coordinates; cells: (m, 2) node indices (lines) or
+    (m, 3) (triangles); all cells form the group ``cell_name``; point_groups:
+    name → node indices. The arrays are read on rank 0 and distributed.
     """
     import ufl
 
@@ -162,18 +162,23 @@ def from_arrays(points: np.ndarray, cells: np.ndarray, cell_name: str = "all",
     gdim = points.shape[1]
     cells = np.asarray(cells, dtype=np.int64)
     point_groups = point_groups or {}
-    domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.Cell("interval", geometric_dimension=gdim), 1))
+    nv = cells.shape[1]
+    if nv not in (2, 3):
+        raise ValueError(f"from_arrays: cells must have 2 (lines) or 3 (triangles) nodes, got {nv}")
+    cell = "interval" if nv == 2 else "triangle"
+    domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.Cell(cell, geometric_dimension=gdim), 1))
     if comm.rank == 0:
         msh = dolfinx.mesh.create_mesh(comm, cells, points, domain)
     else:
-        msh = dolfinx.mesh.create_mesh(comm, np.empty((0, 2), dtype=np.int64), np.empty((0, gdim)), domain)
-    cmap = msh.topology.index_map(1)
+        msh = dolfinx.mesh.create_mesh(comm, np.empty((0, nv), dtype=np.int64), np.empty((0, gdim)), domain)
+    tdim = nv - 1
+    cmap = msh.topology.index_map(tdim)
     local = np.arange(cmap.size_local + cmap.num_ghosts, dtype=np.int32)
-    tags = dolfinx.mesh.meshtags(msh, 1, local, np.ones(len(local), dtype=np.int32))
+    tags = dolfinx.mesh.meshtags(msh, tdim, local, np.ones(len(local), dtype=np.int32))
     pts = {}
     for name, idx in point_groups.items():
         p = np.zeros((len(idx), 3))
         p[:, :gdim] = points[np.asarray(idx, dtype=np.int64)] if comm.rank == 0 else 0.0
         pts[name] = comm.bcast(p if comm.rank == 0 else None, root=0)
-    groups = {cell_name: (1, 1), **{name: (0, 100 + k) for k, name in enumerate(point_groups)}}
+    groups = {cell_name: (tdim, 1), **{name: (0, 100 + k) for k, name in enumerate(point_groups)}}
     return TaggedMesh(msh, tags, groups, pts)

@@ -32,13 +32,16 @@ class TaggedMesh:
 
     mesh: the DOLFINx mesh; cell_tags: its cell MeshTags (gmsh physical tags);
     groups: name → (dim, physical tag); points: name → (n, 3) coordinates of
-    the nodes of each group of dimension < tdim, the same on every rank.
+    the nodes of each group of dimension < tdim, the same on every rank;
+    node_ids: name → input node numbers, which take precedence over the
+    coordinates (nodes that share a position, as on the two sides of a slit).
     """
 
     mesh: dolfinx.mesh.Mesh
     cell_tags: dolfinx.mesh.MeshTagsMetaClass
     groups: dict[str, tuple[int, int]]
     points: dict[str, np.ndarray] = field(default_factory=dict)
+    node_ids: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def tdim(self) -> int:
@@ -72,8 +75,23 @@ class TaggedMesh:
             counts = np.diff(c2v.offsets)[cells]
             idx = np.repeat(c2v.offsets[cells], counts) + _ramp(counts)
             return np.unique(c2v.array[idx]).astype(np.int32)
+        if name in self.node_ids:
+            return _vertices_of_input_nodes(self.mesh, self.node_ids[name])
         pts = self.points[name]
         return _locate_vertices(self.mesh, pts)
+
+
+def _vertices_of_input_nodes(mesh: dolfinx.mesh.Mesh, ids: np.ndarray) -> np.ndarray:
+    """Local vertices (owned and ghost) of the input nodes ``ids`` (P1 geometry: node = vertex)."""
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim, 0)
+    c2v = mesh.topology.connectivity(tdim, 0).array
+    gdofs = mesh.geometry.dofmap.array
+    vertex_of_node = np.empty(len(mesh.geometry.x), dtype=np.int32)
+    vertex_of_node[gdofs] = c2v
+    inputs = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)
+    nodes = np.flatnonzero(np.isin(inputs, np.asarray(ids, dtype=np.int64)))
+    return np.unique(vertex_of_node[nodes]).astype(np.int32)
 
 
 def _ramp(counts: np.ndarray) -> np.ndarray:
@@ -175,10 +193,12 @@ def from_arrays(points: np.ndarray, cells: np.ndarray, cell_name: str = "all",
     cmap = msh.topology.index_map(tdim)
     local = np.arange(cmap.size_local + cmap.num_ghosts, dtype=np.int32)
     tags = dolfinx.mesh.meshtags(msh, tdim, local, np.ones(len(local), dtype=np.int32))
-    pts = {}
+    pts, ids = {}, {}
     for name, idx in point_groups.items():
+        idx = np.asarray(idx, dtype=np.int64)
         p = np.zeros((len(idx), 3))
-        p[:, :gdim] = points[np.asarray(idx, dtype=np.int64)] if comm.rank == 0 else 0.0
+        p[:, :gdim] = points[idx] if comm.rank == 0 else 0.0
         pts[name] = comm.bcast(p if comm.rank == 0 else None, root=0)
+        ids[name] = comm.bcast(idx if comm.rank == 0 else None, root=0)
     groups = {cell_name: (tdim, 1), **{name: (0, 100 + k) for k, name in enumerate(point_groups)}}
-    return TaggedMesh(msh, tags, groups, pts)
+    return TaggedMesh(msh, tags, groups, pts, ids)

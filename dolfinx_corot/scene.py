@@ -82,6 +82,9 @@ class Scene:
         if not isinstance(material, Elastic):
             raise TypeError(f"beam '{where}': material must be dc.Elastic, got {type(material).__name__}")
         model = self._model(tmesh)
+        if isinstance(model, Shell3D):
+            raise ValueError(f"beam '{where}': beams need a mesh of lines; this mesh has triangles "
+                             "(beams sharing nodes with shells are not supported yet)")
         E, G = material.E, material.G
         if kinematics == "timoshenko" and section.As <= 0.0:
             raise ValueError(f"beam '{where}': Timoshenko kinematics needs a shear area As > 0")
@@ -125,6 +128,8 @@ class Scene:
         if not area > 0.0:
             raise ValueError(f"truss '{where}': area = {area} must be positive")
         model = self._model(tmesh)
+        if isinstance(model, Shell3D):
+            raise ValueError(f"truss '{where}': bars need a mesh of lines; this mesh has triangles")
         if isinstance(model, Frame2D):
             return model.add_beam(where, material.E * area, 0.0, 0.0, float(prestress_force), "truss")
         _, d = model._element_vectors(tmesh.cells(where))

@@ -148,3 +148,15 @@ def test_membrane_strip_in_tension_after_a_large_rotation():
     expected = (Q @ X.T).T * 1.0 + np.outer(X[:, 0] / L * delta, a) - X
     np.testing.assert_allclose(st[:, :3], expected, atol=eps * delta)
     assert sc.effects()[0].startswith("membrane elements")
+
+
+def test_line_elements_on_a_triangle_mesh_are_refused():
+    import dolfinx_corot as dc
+    from dolfinx_corot.io import from_arrays
+
+    pts = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    tm = from_arrays(pts, np.array([[0, 1, 2]]), "s")
+    with pytest.raises(ValueError, match="beams need a mesh of lines; this mesh has triangles"):
+        dc.Scene().add_beam(tm, "s", section=dc.Rectangle(1, 1), material=dc.Elastic(1.0))
+    with pytest.raises(ValueError, match="thickness = 0.0 must be positive"):
+        dc.Scene().add_shell(tm, "s", thickness=0.0, material=dc.Elastic(1.0))

@@ -22,6 +22,7 @@ test: setup
 
 bench: setup
 	$(PY) benchmarks/beam2d.py
+	$(PY) benchmarks/pullout.py
 	$(PY) benchmarks/frame3d.py --sizes 7 15 32   # 10³, 10⁴, 10⁵ elements: about 20 minutes
 
 # numba's on-disk cache does not see edits of inlined callees in other modules

@@ -12,8 +12,8 @@
 # Seed §2.4.1. An open-ended cylinder ($R = 4.953$, $L = 10.35$, $t = 0.094$,
 # $E = 10.5\cdot10^6$, $\nu = 0.3125$) is pulled apart by two diametrically
 # opposite radial forces $P$ at mid-length, up to $P = 40\,000$. One eighth is
-# modelled, with symmetry conditions (normal displacement and in-plane
-# rotations zero) on the three planes. As in the seed the analysis is driven
+# modelled (`cylinder_eighth`: structured triangles from gmsh), with symmetry
+# conditions (normal displacement and in-plane rotations zero) on the three planes. As in the seed the analysis is driven
 # by the radial displacement of the load point A; the force is the reaction
 # there (×4 for the two symmetry planes through A). Recorded: radial
 # displacements at A and at the free-edge points B (above A) and C (on the
@@ -37,6 +37,7 @@ from mpi4py import MPI
 
 import dolfinx_corot as dc
 from dolfinx_corot.io import output_dir
+from dolfinx_corot.io.gmsh_models import cylinder_eighth
 
 comm = MPI.COMM_WORLD
 logging.basicConfig(level=logging.WARNING)
@@ -50,38 +51,10 @@ def say(*args):
         print(*args, flush=True)
 
 
-def eighth_cylinder(n_theta, n_x):
-    """Structured triangles on x ∈ [0, L/2], θ ∈ [0, 90°] (θ from the z axis towards y)."""
-    import gmsh
-
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-        c0, c1 = g.addPoint(0, 0, 0), g.addPoint(L / 2, 0, 0)
-        A, D = g.addPoint(0, 0, R), g.addPoint(0, R, 0)
-        B, C = g.addPoint(L / 2, 0, R), g.addPoint(L / 2, R, 0)
-        mid, free = g.addCircleArc(A, c0, D), g.addCircleArc(B, c1, C)
-        top, side = g.addLine(A, B), g.addLine(D, C)
-        surface = g.addSurfaceFilling([g.addCurveLoop([top, free, -side, -mid])])
-        g.synchronize()
-        for line, n in ((mid, n_theta), (free, n_theta), (top, n_x), (side, n_x)):
-            gmsh.model.mesh.setTransfiniteCurve(line, n + 1)
-        gmsh.model.mesh.setTransfiniteSurface(surface)
-        for dim, tags, tag, name in ((2, [surface], 1, "shell"), (1, [mid], 2, "mid"), (1, [top], 3, "top"),
-                                     (1, [side], 4, "side"), (0, [A], 5, "A"), (0, [B], 6, "B"), (0, [C], 7, "C")):
-            gmsh.model.addPhysicalGroup(dim, tags, tag)
-            gmsh.model.setPhysicalName(dim, tag, name)
-        gmsh.model.mesh.generate(2)
-    tmesh = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=3, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
-    return tmesh
-
-
 def pullout(n_theta, n_x, w_max=3.0, steps=30):
     scene = dc.Scene(large_rotations=True)
-    shell = scene.add_shell(eighth_cylinder(n_theta, n_x), "shell", thickness=t, material=dc.Elastic(E, nu))
+    shell = scene.add_shell(cylinder_eighth(R, L, n_theta, n_x, comm=comm), "shell", thickness=t,
+                            material=dc.Elastic(E, nu))
     scene.fix(shell, "mid", dofs=("ux", "ry", "rz"))   # plane x = 0
     scene.fix(shell, "top", dofs=("uy", "rx", "rz"))   # plane y = 0
     scene.fix(shell, "side", dofs=("uz", "rx", "ry"))  # plane z = 0

@@ -52,3 +52,40 @@ def polyline(points: Sequence[Sequence[float]], elements_per_segment: int | Sequ
     finally:
         if comm.rank == 0:
             gmsh.finalize()
+
+
+def cylinder_eighth(radius: float, length: float, n_theta: int, n_x: int,
+                    comm: MPI.Comm = MPI.COMM_WORLD) -> TaggedMesh:
+    """One eighth of an open cylinder (axis x), structured triangles, for pull-out problems.
+
+    x ∈ [0, length/2], θ ∈ [0, 90°] measured from the z axis towards y. Groups:
+    'shell' (surface), 'mid' (edge on x = 0), 'top' (edge on y = 0), 'side'
+    (edge on z = 0), points 'A' (0, 0, R), 'B' (L/2, 0, R), 'C' (L/2, R, 0).
+    """
+    import gmsh
+
+    R, L = float(radius), float(length)
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        g = gmsh.model.geo
+        c0, c1 = g.addPoint(0, 0, 0), g.addPoint(L / 2, 0, 0)
+        A, D = g.addPoint(0, 0, R), g.addPoint(0, R, 0)
+        B, C = g.addPoint(L / 2, 0, R), g.addPoint(L / 2, R, 0)
+        mid, free = g.addCircleArc(A, c0, D), g.addCircleArc(B, c1, C)
+        top, side = g.addLine(A, B), g.addLine(D, C)
+        surface = g.addSurfaceFilling([g.addCurveLoop([top, free, -side, -mid])])
+        g.synchronize()
+        for line, n in ((mid, n_theta), (free, n_theta), (top, n_x), (side, n_x)):
+            gmsh.model.mesh.setTransfiniteCurve(line, int(n) + 1)
+        gmsh.model.mesh.setTransfiniteSurface(surface)
+        for dim, tags, tag, name in ((2, [surface], 1, "shell"), (1, [mid], 2, "mid"), (1, [top], 3, "top"),
+                                     (1, [side], 4, "side"), (0, [A], 5, "A"), (0, [B], 6, "B"), (0, [C], 7, "C")):
+            gmsh.model.addPhysicalGroup(dim, tags, tag)
+            gmsh.model.setPhysicalName(dim, tag, name)
+        gmsh.model.mesh.generate(2)
+    try:
+        return from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=3, comm=comm)
+    finally:
+        if comm.rank == 0:
+            gmsh.finalize()

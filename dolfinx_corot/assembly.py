@@ -95,31 +95,18 @@ class System:
 
     def __init__(self, model: Model, options_prefix: str = "dc_newton_", symmetric: bool | None = None):
         self.model = model
-        self.comm = model.V.mesh.comm
-        self.L, self.a = model.forms()
-        self.bcs = model.dirichlet_bcs()
-        self.A = dolfinx.fem.petsc.create_matrix(self.a)
-        self.b = dolfinx.fem.petsc.create_vector(self.L)
+        self.comm = model.comm
+        self._build()
         self.fint = self.b.duplicate()
         self.dx = self.b.duplicate()
         self.step_dx = self.b.duplicate()
         self.lift = self.b.duplicate()
         self._prescribed = bool(getattr(model, "has_prescribed_motion", False))
         self.load_factor = 0.0
-        self.fext = self.b.duplicate()
-        with self.fext.localForm() as f:
-            f.set(0.0)
-        model.external_force(self.fext)
-        self.fext.assemble()
+        self.fext = self._external_force(None)
         self._fext_norm = self.fext.norm()
         # loads with their own amplitudes g(λ)
-        self.amplitude_loads = []
-        for amp in getattr(model, "amplitudes", []):
-            v = self.b.duplicate()
-            with v.localForm() as f:
-                f.set(0.0)
-            model.external_force(v, amp)
-            self.amplitude_loads.append((amp, v))
+        self.amplitude_loads = [(amp, self._external_force(amp)) for amp in getattr(model, "amplitudes", [])]
         self.fext_total = self.b.duplicate()
         self.timings = Timings()
 
@@ -141,6 +128,63 @@ class System:
             pc.setFactorSetUpSolverType()
             pc.getFactorMatrix().setMumpsIcntl(24, 1)
 
+    # -- layout (one mesh: DOLFINx's own) -------------------------------------------
+    def _build(self) -> None:
+        self.L, self.a = self.model.forms()
+        self.bcs = self.model.dirichlet_bcs()
+        self.A = dolfinx.fem.petsc.create_matrix(self.a)
+        self.b = dolfinx.fem.petsc.create_vector(self.L)
+
+    def _external_force(self, amplitude) -> PETSc.Vec:
+        """Assembled unit external load of one amplitude (None: the loads proportional to λ)."""
+        v = self.b.duplicate()
+        with v.localForm() as f:
+            f.set(0.0)
+        self.model.external_force(v, amplitude)
+        v.assemble()
+        return v
+
+    def _assemble_fint(self) -> None:
+        with self.fint.localForm() as f:
+            f.set(0.0)
+        dolfinx.fem.petsc.assemble_vector(self.fint, self.L)
+        self.fint.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+
+    def _constrain_residual(self, load_factor: float) -> None:
+        x = self.model.displacement_vector()
+        if self._prescribed:
+            self.model.set_load_factor(load_factor)
+            with self.lift.localForm() as f:
+                f.set(0.0)
+            dolfinx.fem.petsc.apply_lifting(self.lift, [self.a], bcs=[self.bcs], x0=[x], scale=1.0)
+            self.lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            self.b.axpy(1.0, self.lift)
+        dolfinx.fem.petsc.set_bc(self.b, self.bcs, x, 1.0)
+
+    def model_array(self, model, vec: PETSc.Vec) -> np.ndarray:
+        """Local values (owned and ghost) of ``vec`` in the layout of ``model.V``."""
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with vec.localForm() as f:
+            return f.array.copy()
+
+    def global_arrays(self, vectors: dict) -> dict:
+        """Configuration and vectors as node-ordered arrays on rank 0 (checkpoint files)."""
+        model = self.model
+        arrays = {"state": model.to_global(model.state.x.array)}
+        for name, vec in vectors.items():
+            with vec.localForm() as v:
+                arrays[name] = model.to_global(v.array)
+        return arrays
+
+    def set_global_arrays(self, arrays: dict) -> None:
+        """Restore the configuration from :meth:`global_arrays`' output (read on every rank)."""
+        self.model.state.x.array[:] = self.model.from_global(arrays["state"])
+
+    def global_to_vector(self, arrays: dict, name: str, vec: PETSc.Vec) -> None:
+        """Fill ``vec`` (owned and ghost) from the arrays of :meth:`global_arrays` (entry ``name``)."""
+        with vec.localForm() as v:
+            v.array[:] = self.model.from_global(arrays[name])
+
     # -- residual -----------------------------------------------------------
     def residual(self, load_factor: float) -> tuple[float, float]:
         """Assemble b = λ f_ext + Σ g(λ) f_g − f_int; on constrained dofs b = ū(λ) − x (0 on supports).
@@ -153,10 +197,7 @@ class System:
         """
         t = time.perf_counter()
         self.load_factor = load_factor
-        with self.fint.localForm() as f:
-            f.set(0.0)
-        dolfinx.fem.petsc.assemble_vector(self.fint, self.L)
-        self.fint.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self._assemble_fint()
         self.fext.copy(self.fext_total)
         self.fext_total.scale(load_factor)
         for amp, v in self.amplitude_loads:
@@ -164,15 +205,7 @@ class System:
         ref = max(self.fext_total.norm(), self.fint.norm())
         self.fext_total.copy(self.b)
         self.b.axpy(-1.0, self.fint)
-        x = self.model.displacement_vector()
-        if self._prescribed:
-            self.model.set_load_factor(load_factor)
-            with self.lift.localForm() as f:
-                f.set(0.0)
-            dolfinx.fem.petsc.apply_lifting(self.lift, [self.a], bcs=[self.bcs], x0=[x], scale=1.0)
-            self.lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-            self.b.axpy(1.0, self.lift)
-        dolfinx.fem.petsc.set_bc(self.b, self.bcs, x, 1.0)
+        self._constrain_residual(load_factor)
         norm = self.b.norm()
         self.timings.assembly += time.perf_counter() - t
         return norm, ref
@@ -274,3 +307,258 @@ def global_sum(comm: MPI.Comm, value: np.ndarray) -> np.ndarray:
     out = np.zeros_like(value)
     comm.Allreduce(np.ascontiguousarray(value), out, op=MPI.SUM)
     return out
+
+
+class DofLayout:
+    """One global numbering for the dofs of models on different meshes.
+
+    A node is identified by (node source, input node number): the meshes read
+    from one gmsh model (or built from one array of points with the same
+    ``node_source``) share the nodes they have in common, which become one
+    node of the system with one set of dofs. A shared node is owned by the
+    rank that owns it in the first model holding it; nodes are numbered rank
+    by rank, so each rank owns a contiguous range of scalar dofs.
+
+    imap: scalar IndexMap of the system (owned, then ghosts); gdofs[i]: global
+    dof of every local unrolled dof (owned and ghost) of model i; local[i]:
+    the same in the local numbering of ``imap``; n_owned, start: this rank's range.
+    """
+
+    def __init__(self, models: Sequence) -> None:
+        comm = models[0].comm
+        sources: list[str] = []
+        keys = []
+        for m in models:
+            if m.tmesh.node_source not in sources:
+                sources.append(m.tmesh.node_source)
+            code = np.int64(sources.index(m.tmesh.node_source))
+            keys.append((code << np.int64(40)) | m._input_ids())
+        allk, allm, allr = [], [], []
+        for i, (m, k) in enumerate(zip(models, keys)):
+            for r, g in enumerate(comm.allgather(k[: m.V.dofmap.index_map.size_local])):
+                allk.append(g)
+                allm.append(np.full(len(g), i, dtype=np.int32))
+                allr.append(np.full(len(g), r, dtype=np.int32))
+        allk, allm, allr = np.concatenate(allk), np.concatenate(allm), np.concatenate(allr)
+        order = np.lexsort((allm, allk))
+        ks = allk[order]
+        first = np.ones(len(order), dtype=bool)
+        first[1:] = ks[1:] != ks[:-1]
+        primary = order[first]
+        ukeys, owner, pmodel = allk[primary], allr[primary], allm[primary]
+        ncomp = np.array([m.ndof for m in models], dtype=np.int64)[pmodel]
+        # every model holding a shared node must give it the same dofs
+        for i, m in enumerate(models):
+            idx = np.searchsorted(ukeys, keys[i])
+            for j in np.unique(pmodel[idx]):
+                if models[j].dof_names != m.dof_names:
+                    raise ValueError(f"parts of kinds {[p.kind for p in m.parts]} and "
+                                     f"{[p.kind for p in models[j].parts]} share nodes but have different dofs "
+                                     f"({m.dof_names} and {models[j].dof_names})")
+        gorder = np.lexsort((ukeys, owner))
+        gnode = np.empty(len(ukeys), dtype=np.int64)
+        gnode[gorder] = np.arange(len(ukeys))
+        offsets_in_order = np.concatenate([[0], np.cumsum(ncomp[gorder])])
+        offset = offsets_in_order[gnode]
+        per_rank = np.bincount(owner, weights=ncomp, minlength=comm.size).astype(np.int64)
+        self.start = int(per_rank[: comm.rank].sum())
+        self.n_owned = int(per_rank[comm.rank])
+        self.size_global = int(per_rank.sum())
+        self.gdofs, owners = [], []
+        for i, m in enumerate(models):
+            idx = np.searchsorted(ukeys, keys[i])
+            self.gdofs.append((offset[idx][:, None] + np.arange(m.ndof)).ravel())
+            owners.append(np.repeat(owner[idx], m.ndof))
+        alld, allo = np.concatenate(self.gdofs), np.concatenate(owners)
+        outside = (alld < self.start) | (alld >= self.start + self.n_owned)
+        ghosts, first_at = np.unique(alld[outside], return_index=True)
+        ghost_owners = allo[outside][first_at].astype(np.int32)
+        self.ghosts = ghosts
+        self.imap = dolfinx.cpp.common.IndexMap(comm, self.n_owned, ghosts.astype(np.int64), ghost_owners)
+        self.local = []
+        for gd in self.gdofs:
+            own = (gd >= self.start) & (gd < self.start + self.n_owned)
+            self.local.append(np.where(own, gd - self.start,
+                                       self.n_owned + np.searchsorted(ghosts, gd)).astype(np.int32))
+
+
+class CoupledSystem(System):
+    """:class:`System` of parts on several meshes (``model.models``), stacked by a :class:`DofLayout`.
+
+    Each model's kernels are assembled by DOLFINx into one PETSc matrix
+    whose pattern is the union of the models' cell patterns: the matrix's
+    local-to-global map is switched to each model's dofs in turn, so shared
+    nodes sum their contributions. Supports and prescribed motion act on the
+    system's dofs (MatZeroRowsColumns with the lifting of prescribed values);
+    rotations without bending stiffness in every model are fixed.
+    """
+
+    def _build(self) -> None:
+        models = self.model.models
+        self.layout = lay = DofLayout(models)
+        comm = self.comm
+        sp = dolfinx.cpp.la.SparsityPattern(comm, [lay.imap, lay.imap], [1, 1])
+        for m, loc in zip(models, lay.local):
+            cells = m.V.dofmap.list.array.reshape(-1, m.tdim + 1)
+            dofs = loc[(cells[:, :, None] * m.ndof + np.arange(m.ndof)).reshape(len(cells), -1)]
+            for row in dofs:
+                sp.insert(row, row)
+        sp.insert_diagonal(np.arange(lay.n_owned, dtype=np.int32))
+        sp.assemble()
+        self.A = dolfinx.cpp.la.petsc.create_matrix(comm, sp)
+        self.b = dolfinx.cpp.la.petsc.create_vector(lay.imap, 1)
+        self._model_forms = [m.forms() for m in models]
+        self._lgmaps = [PETSc.LGMap().create(gd.astype(PETSc.IntType), comm=comm) for gd in lay.gdofs]
+        self._mvec = [dolfinx.fem.petsc.create_vector(L) for L, _ in self._model_forms]
+        self._xglobal = self.b.duplicate()
+        self._constraints, self._fixed = self._gather_constraints()
+        self._lift_pending = False
+
+    # -- moving values between the models' layouts and the system's ---------------
+    def _add_from_models(self, vec: PETSc.Vec, arrays: Sequence[np.ndarray]) -> None:
+        """vec = Σ over models of their local arrays (owned and ghost entries), summed on the owners."""
+        with vec.localForm() as f:
+            f.set(0.0)
+            for loc, arr in zip(self.layout.local, arrays):
+                f.array[loc] += arr
+        vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+
+    def model_array(self, model, vec: PETSc.Vec) -> np.ndarray:
+        i = self.model.models.index(model)
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with vec.localForm() as f:
+            return f.array[self.layout.local[i]].copy()
+
+    def _owned_indicator(self, arrays: Sequence[np.ndarray]) -> np.ndarray:
+        """Owned entries of Σ models' local arrays (a reduction over ranks)."""
+        v = self.b.duplicate()
+        self._add_from_models(v, arrays)
+        out = v.array.copy()
+        v.destroy()
+        return out
+
+    def _gather_constraints(self):
+        """[(owned local rows, value, amplitude)] of supports and prescribed motion; and all fixed rows."""
+        models = self.model.models
+        groups = []
+        for i, m in enumerate(models):
+            for dofs, value, amp in m.constraint_dofs():
+                arrays = [np.zeros(len(loc)) for loc in self.layout.local]
+                arrays[i][dofs] = 1.0
+                groups.append((np.flatnonzero(self._owned_indicator(arrays) > 0).astype(np.int32), value, amp))
+        # rotations that no model gives bending stiffness
+        rot, bend = [], []
+        for m in models:
+            r = np.zeros((len(m.bending_blocks()), m.ndof))
+            r[:, m.translations:] = 1.0
+            rot.append(r.ravel())
+            bend.append((r * m.bending_blocks()[:, None]).ravel())
+        free = (self._owned_indicator(rot) > 0) & (self._owned_indicator(bend) == 0)
+        groups.append((np.flatnonzero(free).astype(np.int32), 0.0, None))
+        fixed = np.unique(np.concatenate([g[0] for g in groups])).astype(np.int32)
+        return groups, fixed
+
+    # -- System hooks --------------------------------------------------------------
+    def _external_force(self, amplitude) -> PETSc.Vec:
+        arrays = []
+        for m, v in zip(self.model.models, self._mvec):
+            with v.localForm() as f:
+                f.set(0.0)
+            m.external_force(v, amplitude)
+            with v.localForm() as f:
+                arrays.append(f.array.copy())
+        out = self.b.duplicate()
+        self._add_from_models(out, arrays)
+        return out
+
+    def _assemble_fint(self) -> None:
+        arrays = []
+        for (L, _), v in zip(self._model_forms, self._mvec):
+            with v.localForm() as f:
+                f.set(0.0)
+            dolfinx.fem.petsc.assemble_vector(v, L)
+            with v.localForm() as f:
+                arrays.append(f.array.copy())
+        self._add_from_models(self.fint, arrays)
+
+    def _displacements(self) -> np.ndarray:
+        """Owned entries of the displacement vector (rotational entries 0)."""
+        with self._xglobal.localForm() as f:
+            for m, loc in zip(self.model.models, self.layout.local):
+                with m.displacement_vector().localForm() as x:
+                    f.array[loc] = x.array
+        return self._xglobal.array
+
+    def _constrain_residual(self, load_factor: float) -> None:
+        x = self._displacements()
+        with self.lift.localForm() as f:
+            f.set(0.0)
+        lift = self.lift.array
+        for rows, value, amp in self._constraints:
+            target = value * (load_factor if amp is None else amp(load_factor))
+            lift[rows] = target - x[rows]
+        self.b.array[self._fixed] = lift[self._fixed]
+        self._lift_pending = True
+
+    def jacobian(self) -> None:
+        t = time.perf_counter()
+        A = self.A
+        A.zeroEntries()
+        lg0 = A.getLGMap()
+        for (_, a), lg in zip(self._model_forms, self._lgmaps):
+            A.setLGMap(lg, lg)
+            dolfinx.cpp.fem.petsc.assemble_matrix(A, a, dolfinx.fem.petsc._pack_constants(a),
+                                                  dolfinx.fem.petsc._pack_coefficients(a), [], True)
+        A.setLGMap(*lg0)
+        A.assemble()
+        rows = (self._fixed + self.layout.start).astype(PETSc.IntType)
+        if self._lift_pending and self._prescribed:
+            A.zeroRowsColumns(rows, 1.0, self.lift, self.b)
+        else:
+            A.zeroRowsColumns(rows, 1.0)
+        self._lift_pending = False
+        self.timings.assembly += time.perf_counter() - t
+
+    def reference_load(self, out: PETSc.Vec) -> None:
+        self.fext.copy(out)
+        out.array[self._fixed] = 0.0
+
+    def update(self, scale: float = 1.0) -> None:
+        t = time.perf_counter()
+        self.dx.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with self.dx.localForm() as f:
+            dxl = f.array
+            for m, loc, v in zip(self.model.models, self.layout.local, self._mvec):
+                n = m.V.dofmap.index_map.size_local * m.ndof
+                v.array[:] = scale * dxl[loc[:n]]
+                m.update(v)
+        self.step_dx.axpy(scale, self.dx)
+        self.timings.update += time.perf_counter() - t
+
+    # -- checkpoint files ------------------------------------------------------------
+    def global_arrays(self, vectors: dict) -> dict:
+        arrays = {}
+        for i, m in enumerate(self.model.models):
+            arrays[f"state{i}"] = m.to_global(m.state.x.array)
+            for name, vec in vectors.items():
+                arrays[f"{name}{i}"] = m.to_global(self.model_array(m, vec))
+        return arrays
+
+    def set_global_arrays(self, arrays: dict) -> None:
+        for i, m in enumerate(self.model.models):
+            m.state.x.array[:] = m.from_global(arrays[f"state{i}"])
+
+    def global_to_vector(self, arrays: dict, name: str, vec: PETSc.Vec) -> None:
+        with vec.localForm() as f:
+            for i, (m, loc) in enumerate(zip(self.model.models, self.layout.local)):
+                f.array[loc] = m.from_global(arrays[f"{name}{i}"])
+
+    def destroy(self) -> None:
+        super().destroy()
+        for obj in (*self._mvec, self._xglobal, *self._lgmaps):
+            obj.destroy()
+
+
+def make_system(model, **kwargs) -> System:
+    """The :class:`System` of a model: DOLFINx's layout for one mesh, a :class:`CoupledSystem` for several."""
+    return CoupledSystem(model, **kwargs) if hasattr(model, "models") else System(model, **kwargs)

@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numba
+from mpi4py import MPI
 import numpy as np
 from petsc4py import PETSc
 
@@ -75,6 +76,10 @@ class LineFrame:
         self._prescribed: list[tuple[np.ndarray, int, float, object]] = []
         self._prescribed_values: list[tuple[dolfinx.fem.Function, np.ndarray, float, object]] = []
         self._forms = None
+
+    @property
+    def comm(self):
+        return self.V.mesh.comm
 
     # -- building -----------------------------------------------------------
     def add_elements(self, where: str | None, props: np.ndarray, bending: bool, kind: str) -> PartRef:
@@ -141,7 +146,7 @@ class LineFrame:
         if self._forms is None:
             cmap = self.tmesh.mesh.topology.index_map(self.tdim)
             owned = np.flatnonzero(self._owner_of_cell[: cmap.size_local] != "").astype(np.int32)
-            all_owned = self.V.mesh.comm.allreduce(len(owned) == cmap.size_local)
+            all_owned = self.V.mesh.comm.allreduce(bool(len(owned) == cmap.size_local), op=MPI.LAND)
             cells = None if all_owned else owned
             self._flag = dolfinx.fem.Constant(self.V.mesh, PETSc.ScalarType(1.0 if self.large_rotations else 0.0))
             coeffs = [self.state, self.props]
@@ -154,11 +159,13 @@ class LineFrame:
         """Supports (zero) and prescribed displacements (λ-scaled values, see :meth:`set_load_factor`)."""
         zero = PETSc.ScalarType(0.0)
         bcs = []
-        rotations_free = tuple(range(self.translations, self.ndof))
-        for vertices, comps in self._bcs + [(self._rotation_free_vertices(), rotations_free)]:
+        for vertices, comps in self._bcs:
             for comp in comps:
                 dofs = dolfinx.fem.locate_dofs_topological(self.V.sub(comp), 0, vertices)
                 bcs.append(dolfinx.fem.dirichletbc(zero, dofs, self.V.sub(comp)))
+        free = self._rotation_free_blocks()
+        for comp in range(self.translations, self.ndof):
+            bcs.append(dolfinx.fem.dirichletbc(zero, free * self.ndof + comp, self.V.sub(comp)))
         self._prescribed_values = []
         for vertices, comp, value, amplitude in self._prescribed:
             Vi, _ = self.V.sub(comp).collapse()
@@ -177,22 +184,34 @@ class LineFrame:
         for g, dofs, value, amplitude in self._prescribed_values:
             g.x.array[dofs] = (load_factor if amplitude is None else amplitude(load_factor)) * value
 
-    def _rotation_free_vertices(self) -> np.ndarray:
-        """Vertices touched by no bending element: their rotation has no stiffness and is fixed."""
-        mesh = self.tmesh.mesh
-        mesh.topology.create_connectivity(0, self.tdim)
-        v2c = mesh.topology.connectivity(0, self.tdim)
-        vmap = mesh.topology.index_map(0)
-        nv = vmap.size_local + vmap.num_ghosts
-        counts = np.add.reduceat(self._bending[v2c.array].astype(np.int32), v2c.offsets[:-1][:nv])
-        bending = counts > 0
-        # a vertex may see its bending cell only on another rank: reduce over owners
-        flag = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1)))
-        vert_to_dof = dolfinx.fem.locate_dofs_topological(flag.function_space, 0, np.arange(nv, dtype=np.int32))
-        flag.x.array[vert_to_dof] = bending.astype(float)
+    def bending_blocks(self) -> np.ndarray:
+        """Local blocks (owned and ghost) that a bending element on this rank touches."""
+        nblocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
+        flags = np.zeros(nblocks, dtype=bool)
+        dofs = self.V.dofmap.list.array.reshape(-1, self.tdim + 1)
+        flags[dofs[self._bending[: len(dofs)]].ravel()] = True
+        return flags
+
+    def _rotation_free_blocks(self) -> np.ndarray:
+        """Blocks touched by no bending element (on any rank): their rotation has no stiffness."""
+        flag = dolfinx.fem.Function(self.V)
+        flag.x.array.reshape(-1, self.ndof)[:, 0] = self.bending_blocks()
         flag.x.scatter_reverse(dolfinx.la.ScatterMode.add)
         flag.x.scatter_forward()
-        return np.flatnonzero(flag.x.array[vert_to_dof] == 0.0).astype(np.int32)
+        return np.flatnonzero(flag.x.array.reshape(-1, self.ndof)[:, 0] == 0.0).astype(np.int32)
+
+    def constraint_dofs(self) -> list[tuple[np.ndarray, float, object]]:
+        """[(local unrolled dofs of V, value, amplitude)]: supports (value 0) and prescribed motion
+        (value·λ or value·amplitude(λ)); rotations without stiffness are not included."""
+        out = []
+        for vertices, comps in self._bcs:
+            blocks = dolfinx.fem.locate_dofs_topological(self.V, 0, vertices)
+            for comp in comps:
+                out.append((blocks * self.ndof + comp, 0.0, None))
+        for vertices, comp, value, amplitude in self._prescribed:
+            blocks = dolfinx.fem.locate_dofs_topological(self.V, 0, vertices)
+            out.append((blocks * self.ndof + comp, value, amplitude))
+        return out
 
     def external_force(self, b: PETSc.Vec, amplitude=None) -> None:
         """Add the loads with the given amplitude (None: those proportional to λ) at unit factor."""
@@ -205,11 +224,10 @@ class LineFrame:
                 blocks = assembly.owned_dofs_of_vertices(self.V, vertices)
                 arr[blocks[blocks < n_owned]] += values
 
-    def reaction(self, where: str, fint: PETSc.Vec) -> np.ndarray:
-        """Sum over the nodes of ``where`` of an assembled nodal vector (all ranks)."""
+    def reaction(self, where: str, values: np.ndarray) -> np.ndarray:
+        """Sum over the nodes of ``where`` of an assembled nodal vector given as local array of V (all ranks)."""
         blocks = assembly.owned_dofs_of_vertices(self.V, self.tmesh.vertices(where))
-        with fint.localForm() as f:
-            local = f.array.reshape(-1, self.ndof)[blocks].sum(axis=0) if len(blocks) else np.zeros(self.ndof)
+        local = values.reshape(-1, self.ndof)[blocks].sum(axis=0) if len(blocks) else np.zeros(self.ndof)
         return assembly.global_sum(self.V.mesh.comm, np.asarray(local, dtype=float))
 
     def checkpoint(self) -> np.ndarray:
@@ -428,3 +446,47 @@ class Shell3D(LineFrame):
             p = x[g[bad[0], 0]]
             raise ValueError(f"{label}: {len(bad)} triangle(s) of zero area, the first at "
                              f"({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g})")
+
+
+class Coupled:
+    """Structural models on several meshes, solved as one system (:class:`assembly.CoupledSystem`).
+
+    Meshes of one node source (one gmsh model) share their common nodes: a
+    beam along a shell's edge or across its surface moves with it, dofs for
+    dofs. Models that share no node are still solved together (they interact
+    through supports, loads or, later, contact).
+    """
+
+    def __init__(self, models: list[LineFrame]):
+        self.models = list(models)
+        self.large_rotations = self.models[0].large_rotations
+
+    @property
+    def comm(self):
+        return self.models[0].comm
+
+    @property
+    def symmetric_tangent(self) -> bool:
+        return all(m.symmetric_tangent for m in self.models)
+
+    @property
+    def has_prescribed_motion(self) -> bool:
+        return any(m.has_prescribed_motion for m in self.models)
+
+    @property
+    def amplitudes(self) -> list:
+        out = []
+        for m in self.models:
+            out += [a for a in m.amplitudes if a not in out]
+        return out
+
+    def extrapolate(self, older, newer, factor: float) -> None:
+        for m, o, n in zip(self.models, older, newer):
+            m.extrapolate(o, n, factor)
+
+    def checkpoint(self):
+        return tuple(m.checkpoint() for m in self.models)
+
+    def restore(self, cp) -> None:
+        for m, c in zip(self.models, cp):
+            m.restore(c)

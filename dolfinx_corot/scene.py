@@ -23,7 +23,7 @@ import numpy as np
 
 from .io.mesh import TaggedMesh
 from .materials import Elastic
-from .parts import Frame2D, Frame3D, LineFrame, PartRef, Shell3D
+from .parts import Coupled, Frame2D, Frame3D, LineFrame, PartRef, Shell3D
 from .sections import Section
 
 KINEMATICS = ("bernoulli", "timoshenko")
@@ -47,6 +47,7 @@ class Scene:
     def __init__(self, large_rotations: bool = True):
         self.large_rotations = bool(large_rotations)
         self._models: dict[int, LineFrame] = {}
+        self._coupled: Coupled | None = None
         self.monitors: list[Monitor] = []
         self._loads = 0
         self._prescribed = 0
@@ -58,8 +59,11 @@ class Scene:
         key = id(tmesh)
         if key not in self._models:
             if self._models:
-                raise NotImplementedError("all structural parts must share one mesh (parts on different "
-                                          "meshes are coupled in a later release); put every group in one gmsh model")
+                gdims = {m.gdim for m in self._models.values()}
+                if gdims != {tmesh.mesh.geometry.dim}:
+                    raise ValueError(f"parts of one scene live in one space: this mesh has gdim "
+                                     f"{tmesh.mesh.geometry.dim}, the scene's other parts {sorted(gdims)}")
+            self._coupled = None
             if tmesh.mesh.topology.dim == 2:
                 frame = Shell3D
             else:
@@ -84,7 +88,7 @@ class Scene:
         model = self._model(tmesh)
         if isinstance(model, Shell3D):
             raise ValueError(f"beam '{where}': beams need a mesh of lines; this mesh has triangles "
-                             "(beams sharing nodes with shells are not supported yet)")
+                             "(for beams on shells read the lines as a mesh of their own: from_gmsh(model, 3, dim=1))")
         E, G = material.E, material.G
         if kinematics == "timoshenko" and section.As <= 0.0:
             raise ValueError(f"beam '{where}': Timoshenko kinematics needs a shear area As > 0")
@@ -203,10 +207,15 @@ class Scene:
 
     # -- introspection -----------------------------------------------------------
     @property
-    def model(self) -> LineFrame:
+    def model(self) -> LineFrame | Coupled:
+        """The structural model: one mesh's, or the parts of several meshes coupled."""
         if not self._models:
             raise ValueError("the scene has no parts: add a beam or a truss first")
-        return next(iter(self._models.values()))
+        if len(self._models) == 1:
+            return next(iter(self._models.values()))
+        if self._coupled is None:
+            self._coupled = Coupled(list(self._models.values()))
+        return self._coupled
 
     def effects(self) -> list[str]:
         """What will be assembled, in words."""
@@ -228,8 +237,8 @@ class Scene:
             model = mon.part.model
             if mon.kind == "reaction":
                 # reaction on the structure = λ f_ext − f_int at the constrained nodes
-                fint = model.reaction(mon.where, system.internal_force())
-                fext = model.reaction(mon.where, system.fext_total)
+                fint = model.reaction(mon.where, system.model_array(model, system.internal_force()))
+                fext = model.reaction(mon.where, system.model_array(model, system.fext_total))
                 names = ("Fx", "Fy", "Mz") if model.gdim == 2 else ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
                 for comp, val in zip(names, fext - fint):
                     values[f"{mon.name}_{comp}"] = -float(val)

@@ -35,6 +35,9 @@ class TaggedMesh:
     the nodes of each group of dimension < tdim, the same on every rank;
     node_ids: name → input node numbers, which take precedence over the
     coordinates (nodes that share a position, as on the two sides of a slit).
+    node_source: meshes with the same source number their nodes alike (the
+    gmsh node tags of one gmsh model): parts on such meshes share the nodes
+    they have in common (a beam stiffening a shell).
     """
 
     mesh: dolfinx.mesh.Mesh
@@ -42,6 +45,7 @@ class TaggedMesh:
     groups: dict[str, tuple[int, int]]
     points: dict[str, np.ndarray] = field(default_factory=dict)
     node_ids: dict[str, np.ndarray] = field(default_factory=dict)
+    node_source: str = ""
 
     @property
     def tdim(self) -> int:
@@ -116,11 +120,17 @@ def _locate_vertices(mesh: dolfinx.mesh.Mesh, pts: np.ndarray) -> np.ndarray:
     return dolfinx.mesh.locate_entities(mesh, 0, marker)
 
 
-def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0) -> TaggedMesh:
+def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
+              dim: int | None = None) -> TaggedMesh:
     """Distribute the meshed gmsh ``model`` (alive on ``rank``) as a :class:`TaggedMesh`.
 
-    Every cell of the highest dimension must belong to exactly one physical
-    group (gmsh exports a cell once per group it belongs to).
+    dim: dimension of the cells (default: the highest dimension of the
+    physical groups). A model that holds shells (triangles) and beams (lines)
+    is read twice, ``from_gmsh(model, 3)`` and ``from_gmsh(model, 3, dim=1)``;
+    both meshes keep the gmsh node numbers, so the beams and shells of a scene
+    share the nodes they have in common. Every cell of dimension ``dim`` must
+    belong to exactly one physical group (gmsh exports a cell once per group
+    it belongs to).
     """
     groups: dict[str, tuple[int, int]] = {}
     points: dict[str, np.ndarray] = {}
@@ -129,50 +139,104 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0) 
         phys = model.getPhysicalGroups()
         if not phys:
             error = "the gmsh model has no physical groups: add at least one for the cells"
-        tdim = max((d for d, _ in phys), default=0)
+        tdim = max((d for d, _ in phys), default=0) if dim is None else int(dim)
+        if not error and not any(d == tdim for d, _ in phys):
+            error = f"the gmsh model has no physical group of dimension {tdim} (cells to build a mesh of)"
         seen: dict[int, str] = {}
-        for dim, tag in phys:
-            if dim != tdim or error:
+        for d, tag in phys:
+            if d != tdim or error:
                 continue
-            name = model.getPhysicalName(dim, tag) or f"{dim}:{tag}"
-            for entity in model.getEntitiesForPhysicalGroup(dim, tag):
-                for etags in model.mesh.getElements(dim, entity)[1]:
+            name = model.getPhysicalName(d, tag) or f"{d}:{tag}"
+            for entity in model.getEntitiesForPhysicalGroup(d, tag):
+                for etags in model.mesh.getElements(d, entity)[1]:
                     for e in etags[:1]:
                         if int(e) in seen and seen[int(e)] != name:
                             error = (f"cells belong to two physical groups, '{seen[int(e)]}' and '{name}': "
                                      "each cell must be in exactly one group of its dimension")
                         seen[int(e)] = name
-        for dim, tag in phys:
-            name = model.getPhysicalName(dim, tag) or f"{dim}:{tag}"
+        for d, tag in phys:
+            name = model.getPhysicalName(d, tag) or f"{d}:{tag}"
             if name in groups:
-                error = f"physical group name '{name}' is used twice (dims {groups[name][0]} and {dim})"
-            groups[name] = (dim, tag)
-            if dim < tdim:
-                nodes, coords = model.mesh.getNodesForPhysicalGroup(dim, tag)
+                error = f"physical group name '{name}' is used twice (dims {groups[name][0]} and {d})"
+            groups[name] = (d, tag)
+            if d != tdim:
+                nodes, coords = model.mesh.getNodesForPhysicalGroup(d, tag)
                 points[name] = np.asarray(coords, dtype=float).reshape(-1, 3)
+        source = f"gmsh:{model.getCurrent()}"
+    else:
+        source = None
+        tdim = None
     error = comm.bcast(error, root=rank)
     if error:
         raise ValueError(error)
     groups = comm.bcast(groups, root=rank)
     points = comm.bcast(points, root=rank)
-    msh, cell_tags, _ = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
-    tdim = msh.topology.dim
+    source = comm.bcast(source, root=rank)
+    tdim = comm.bcast(tdim, root=rank)
+    top = max(d for d, _ in groups.values())
+    if tdim == top:
+        msh, cell_tags, _ = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+    else:
+        msh, cell_tags = _lower_dimensional_mesh(model, comm, rank, gdim, tdim)
     ncells_local = msh.topology.index_map(tdim).size_local
     ncells = comm.allreduce(ncells_local, op=MPI.SUM)
     ntagged = comm.allreduce(int(np.sum(cell_tags.indices < ncells_local)), op=MPI.SUM)
     if ntagged != ncells:
         raise ValueError(f"{ncells - ntagged} of {ncells} cells have no physical group")
-    return TaggedMesh(msh, cell_tags, groups, points)
+    return TaggedMesh(msh, cell_tags, groups, points, node_source=source)
+
+
+def _lower_dimensional_mesh(model, comm: MPI.Comm, rank: int, gdim: int, tdim: int):
+    """The cells of dimension ``tdim`` < the model's highest as a mesh (linear lines or triangles);
+    its input node numbers are the gmsh node tags − 1, as for ``gmshio.model_to_mesh``."""
+    import ufl
+
+    cell_name, gmsh_type = {1: ("interval", 1), 2: ("triangle", 2)}[tdim]
+    nv = tdim + 1
+    if comm.rank == rank:
+        tags, coords, _ = model.mesh.getNodes()
+        order = np.argsort(tags)
+        x = np.asarray(coords, dtype=float).reshape(-1, 3)[order]
+        if not np.array_equal(np.asarray(tags)[order], np.arange(1, len(tags) + 1)):
+            raise ValueError("gmsh node tags are not 1..n: call gmsh.model.mesh.renumberNodes()")
+        cells, values = [], []
+        for d, tag in model.getPhysicalGroups():
+            if d != tdim:
+                continue
+            for entity in model.getEntitiesForPhysicalGroup(d, tag):
+                types, _, nodes = model.mesh.getElements(d, entity)
+                for t, n in zip(types, nodes):
+                    if t != gmsh_type:
+                        raise ValueError(f"physical group {tag} of dimension {d} has gmsh elements of type {t}; "
+                                         f"only linear {cell_name}s (type {gmsh_type}) are read")
+                    c = np.asarray(n, dtype=np.int64).reshape(-1, nv) - 1
+                    cells.append(c)
+                    values.append(np.full(len(c), tag, dtype=np.int32))
+        cells = np.concatenate(cells)
+        values = np.concatenate(values)
+    else:
+        cells, values, x = np.empty((0, nv), dtype=np.int64), None, np.empty((0, 3))
+    values = comm.bcast(values, root=rank)
+    domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.Cell(cell_name, geometric_dimension=gdim), 1))
+    msh = dolfinx.mesh.create_mesh(comm, cells, x[:, :gdim], domain)
+    cmap = msh.topology.index_map(tdim)
+    local = np.arange(cmap.size_local + cmap.num_ghosts, dtype=np.int32)
+    original = np.asarray(msh.topology.original_cell_index, dtype=np.int64)
+    tags = dolfinx.mesh.meshtags(msh, tdim, local, values[original[: len(local)]])
+    return msh, tags
 
 
 def from_arrays(points: np.ndarray, cells: np.ndarray, cell_name: str = "all",
                 point_groups: dict[str, np.ndarray] | None = None,
-                comm: MPI.Comm = MPI.COMM_WORLD) -> TaggedMesh:
+                comm: MPI.Comm = MPI.COMM_WORLD, node_source: str | None = None) -> TaggedMesh:
     """A :class:`TaggedMesh` built from arrays (frames, lattices and surfaces made in code).
 
     points: (n, gdim) node coordinates; cells: (m, 2) node indices (lines) or
     (m, 3) (triangles); all cells form the group ``cell_name``; point_groups:
     name → node indices. The arrays are read on rank 0 and distributed.
+    node_source: meshes built from one array of points with the same
+    ``node_source`` share their common nodes when their parts meet in a scene
+    (default: a mesh of its own).
     """
     import ufl
 
@@ -201,4 +265,7 @@ def from_arrays(points: np.ndarray, cells: np.ndarray, cell_name: str = "all",
         pts[name] = comm.bcast(p if comm.rank == 0 else None, root=0)
         ids[name] = comm.bcast(idx if comm.rank == 0 else None, root=0)
     groups = {cell_name: (tdim, 1), **{name: (0, 100 + k) for k, name in enumerate(point_groups)}}
-    return TaggedMesh(msh, tags, groups, pts, ids)
+    if node_source is None:
+        import uuid
+        node_source = comm.bcast(f"arrays:{uuid.uuid4()}" if comm.rank == 0 else None, root=0)
+    return TaggedMesh(msh, tags, groups, pts, ids, node_source=str(node_source))

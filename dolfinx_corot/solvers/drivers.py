@@ -23,7 +23,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..assembly import System
+from ..assembly import System, make_system
 from ..result import History, Result
 from .newton import ConvergenceError, NewtonOptions, NewtonReport, converged, newton
 
@@ -76,12 +76,8 @@ class _Run:
         """
         if self.checkpoint_path is None:
             return
-        model = self.system.model
-        arrays = {"state": model.to_global(model.state.x.array)}
-        for name, vec in (vectors or {}).items():
-            with vec.localForm() as v:
-                arrays[name] = model.to_global(v.array)
-        if model.V.mesh.comm.rank == 0:
+        arrays = self.system.global_arrays(vectors or {})
+        if self.system.comm.rank == 0:
             meta = {"large_rotations": self.scene.large_rotations, "step": self.step,
                     "load_factor": self.load_factor, "cuts": self.cuts, "iterations": self.iterations,
                     "history": self.history.rows, "driver": driver_state}
@@ -102,8 +98,7 @@ class _Run:
         if meta["driver"].get("name") != driver_name:
             raise ValueError(f"the checkpoint {path} was written by {meta['driver'].get('name')}, "
                              f"not {driver_name}")
-        model = self.system.model
-        model.state.x.array[:] = model.from_global(arrays.pop("state"))
+        self.system.set_global_arrays(arrays)
         self.step, self.load_factor = meta["step"], meta["load_factor"]
         self.cuts, self.iterations = meta["cuts"], meta["iterations"]
         for row in meta["history"]:
@@ -251,8 +246,7 @@ class ArcLength:
             arc, arc_min, arc_max = state["arc"], state["arc_min"], state["arc_max"]
             dlam_prev, have_prev = state["dlam_prev"], state["have_prev"]
             lam = run.load_factor
-            with Dx_prev.localForm() as v:
-                v.array[:] = system.model.from_global(arrays["Dx_prev"])
+            system.global_to_vector(arrays, "Dx_prev", Dx_prev)
         while run.step < self.max_steps:
             cp = system.checkpoint()
             started = run.begin()
@@ -369,7 +363,7 @@ def solve(scene, driver, system: System | None = None, on_step=None, checkpoint:
     """
     own_system = system is None
     if own_system:
-        system = System(scene.model)
+        system = make_system(scene.model)
     try:
         return driver.run(_Run(scene, system, on_step, checkpoint), restart)
     finally:

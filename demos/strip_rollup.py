@@ -77,12 +77,12 @@ scene.monitor("tip", strip, "tip")
 say("effects:", scene.effects())
 
 # %% [markdown]
-# ## Twenty load steps to the full circle
+# ## Thirty load steps to the full circle
 
 # %%
 t0 = time.perf_counter()
 with dc.io.FieldWriter(scene, os.path.join(out, "strip.xdmf")) as writer:
-    result = dc.solve(scene, dc.LoadControl(steps=20), on_step=writer)
+    result = dc.solve(scene, dc.LoadControl(steps=30), on_step=writer)
 wall = time.perf_counter() - t0
 hist = result.history
 if comm.rank == 0:

@@ -423,18 +423,21 @@ class Shell3D(LineFrame):
         self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, 3] = 1.0
         self._disp = dolfinx.fem.Function(self.V, name="displacement")
 
-    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float):
+    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str = "opt"):
         label = f"shell '{where}'"
         if not (thickness > 0.0 and np.isfinite(thickness)):
             raise ValueError(f"{label}: thickness = {thickness} must be positive")
         if not drilling > 0.0:
             raise ValueError(f"{label}: the drilling factor {drilling} must be positive")
-        return self.add_elements(where, np.array([E, nu, thickness, drilling, 1.0]), True, "shell")
+        if membrane not in ("opt", "cst"):
+            raise ValueError(f"{label}: membrane '{membrane}' is not one of ('opt', 'cst')")
+        opt = 1.0 if membrane == "opt" else 0.0
+        return self.add_elements(where, np.array([E, nu, thickness, drilling, 1.0, opt]), True, "shell")
 
     def add_membrane(self, where, E: float, nu: float, thickness: float):
         if not (thickness > 0.0 and np.isfinite(thickness)):
             raise ValueError(f"membrane '{where}': thickness = {thickness} must be positive")
-        return self.add_elements(where, np.array([E, nu, thickness, 0.0, 0.0]), False, "membrane")
+        return self.add_elements(where, np.array([E, nu, thickness, 0.0, 0.0, 0.0]), False, "membrane")
 
     def _check_geometry(self, cells, label, props):
         x = self.tmesh.mesh.geometry.x

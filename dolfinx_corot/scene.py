@@ -100,15 +100,20 @@ class Scene:
                                       "GAy": GAs, "GAz": GAs}, orientation, 0.0, "beam")
 
     def add_shell(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float, material: Elastic,
-                  drilling: float = 1e-2) -> PartRef:
-        """Flat co-rotational shell triangles (membrane + drilling + DKT bending) on group ``where``
-        of a triangle mesh in space. drilling: factor α of the drilling penalty α·G·t·A."""
+                  membrane: str = "opt", drilling: float = 1e-2) -> PartRef:
+        """Flat co-rotational shell triangles (membrane with drilling rotations + DKT bending) on
+        group ``where`` of a triangle mesh in space.
+
+        membrane: ``"opt"`` (default), Felippa's optimal ANDES triangle, whose drilling
+        rotations carry real stiffness and which bends in its plane without locking; or
+        ``"cst"``, the constant-strain triangle with a drilling penalty α·G·t·A, α = ``drilling``.
+        """
         if not isinstance(material, Elastic):
             raise TypeError(f"shell '{where}': material must be dc.Elastic, got {type(material).__name__}")
         model = self._model(tmesh)
         if not isinstance(model, Shell3D):
             raise ValueError(f"shell '{where}': shells need a triangle mesh in 3D (from_gmsh(model, gdim=3))")
-        return model.add_shell(where, material.E, material.nu, float(thickness), float(drilling))
+        return model.add_shell(where, material.E, material.nu, float(thickness), float(drilling), membrane)
 
     def add_membrane(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float,
                      material: Elastic) -> PartRef:

@@ -46,11 +46,13 @@ def _scene(meshes, load: bool = True, prescribe: bool = False):
     return sc
 
 
-def test_a_cantilever_cut_in_two_meshes_rolls_up_like_one():
+def test_a_cantilever_cut_in_two_meshes_rolls_up_like_one(tmp_path):
     one = dc.solve(_scene(_one_mesh()), dc.LoadControl(steps=4))
     sc2 = _scene(_two_meshes())
     assert isinstance(make_system(sc2.model), CoupledSystem)
-    two = dc.solve(sc2, dc.LoadControl(steps=4))
+    with dc.io.FieldWriter(sc2, str(tmp_path / "beam.xdmf")) as writer:
+        two = dc.solve(sc2, dc.LoadControl(steps=4), on_step=writer)
+    assert (tmp_path / "beam_0.xdmf").exists() and (tmp_path / "beam_1.h5").exists()
     for key in ("tip_ux", "tip_uy", "tip_rz"):
         np.testing.assert_allclose(two.history.column(key), one.history.column(key), rtol=0, atol=1e-11)
     assert [r["iterations"] for r in two.history.rows] == [r["iterations"] for r in one.history.rows]

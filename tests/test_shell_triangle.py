@@ -1,11 +1,14 @@
-"""Flat shell triangle (CST + drilling + DKT) in its local frame: rigid modes and patch tests."""
+"""Flat shell triangle (OPT or CST membrane + DKT) in its local frame: rigid modes, patch tests,
+and the OPT membrane's exact energy in in-plane bending (Felippa 2003)."""
 import numpy as np
 import pytest
 from scipy.spatial import Delaunay
 
 from dolfinx_corot.elements import shell_triangle as st
 
-PROPS = np.array([2.1e5, 0.3, 0.1, 1e-2, 1.0])
+PROPS = np.array([2.1e5, 0.3, 0.1, 1e-2, 1.0, 1.0])          # OPT membrane
+PROPS_CST = np.array([2.1e5, 0.3, 0.1, 1e-2, 1.0, 0.0])      # CST + drilling penalty
+MEMBRANES = {"opt": PROPS, "cst": PROPS_CST}
 
 
 def _K(xy, props=PROPS):
@@ -14,10 +17,11 @@ def _K(xy, props=PROPS):
     return K
 
 
-def test_rigid_body_modes_cost_nothing():
+@pytest.mark.parametrize("membrane", MEMBRANES)
+def test_rigid_body_modes_cost_nothing(membrane):
     """Six zero-energy modes: three translations, three rotations (the drilling dof follows ω)."""
     xy = np.array([[0.1, 0.2], [1.3, -0.1], [0.4, 0.9]])
-    K = _K(xy)
+    K = _K(xy, MEMBRANES[membrane])
     modes = []
     for k in range(3):  # translations
         m = np.zeros(18)
@@ -53,12 +57,12 @@ def _patch():
     return pts, tri, len(bnd)
 
 
-def _solve_patch(field):
+def _solve_patch(field, props=PROPS):
     pts, tri, nb = _patch()
     n = len(pts)
     K = np.zeros((6 * n, 6 * n))
     for t in tri:
-        Ke = _K(pts[t])
+        Ke = _K(pts[t], props)
         dofs = (6 * t[:, None] + np.arange(6)).ravel()
         K[np.ix_(dofs, dofs)] += Ke
     exact = np.concatenate([field(*p) for p in pts])
@@ -69,7 +73,8 @@ def _solve_patch(field):
     return u, exact
 
 
-def test_membrane_patch_test():
+@pytest.mark.parametrize("membrane", MEMBRANES)
+def test_membrane_patch_test(membrane):
     """A linear in-plane field (constant strain, rigid rotation included) is reproduced exactly."""
     a, b, c, d = 1e-3, -2e-3, 0.5e-3, 1.5e-3
 
@@ -77,7 +82,7 @@ def test_membrane_patch_test():
         u, v = a * x + b * y, c * x + d * y
         return np.array([u, v, 0.0, 0.0, 0.0, 0.5 * (c - b)])
 
-    u, exact = _solve_patch(field)
+    u, exact = _solve_patch(field, MEMBRANES[membrane])
     np.testing.assert_allclose(u, exact, atol=1e-12)
 
 
@@ -104,7 +109,7 @@ def test_cantilever_strip_tip_deflection():
     for i in range(nx):
         a0, a1, b0, b1 = 2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3
         tri += [(a0, b0, b1), (a0, b1, a1)]
-    props = np.array([1e4, 0.0, 0.1, 1e-2, 1.0])
+    props = np.array([1e4, 0.0, 0.1, 1e-2, 1.0, 1.0])
     n = len(pts)
     K = np.zeros((6 * n, 6 * n))
     for t in np.array(tri):
@@ -121,3 +126,44 @@ def test_cantilever_strip_tip_deflection():
     u[free] = np.linalg.solve(K[np.ix_(free, free)], f[free])
     D = 1e4 * 0.1**3 / 12 * b
     np.testing.assert_allclose(u[6 * (n - 1) + 2], M * L**2 / (2 * D), rtol=1e-10)
+
+
+def _rectangle_unit(a, b, nu, props_kind="opt"):
+    """Stiffness (12, 12) on (u, v, θz) of a rectangle a × b cut into two triangles."""
+    X = np.array([[0.0, -b / 2], [a, -b / 2], [a, b / 2], [0.0, b / 2]])
+    K = np.zeros((12, 12))
+    for t in ((0, 1, 2), (0, 2, 3)):
+        if props_kind == "opt":
+            Ke = st.opt_membrane(np.ascontiguousarray(X[list(t)]), 1.0, nu, 1.0)
+        else:
+            Kf = _K(X[list(t)], np.array([1.0, nu, 1.0, 1e-2, 1.0, 0.0]))
+            sel = np.array([0, 1, 5, 6, 7, 11, 12, 13, 17])
+            Ke = Kf[np.ix_(sel, sel)]
+        dofs = np.array([[3 * v, 3 * v + 1, 3 * v + 2] for v in t]).ravel()
+        K[np.ix_(dofs, dofs)] += Ke
+    return X, K
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3, 0.45])
+def test_opt_membrane_is_exact_in_pure_bending_of_rectangles(nu):
+    """Felippa's optimality: the energy of in-plane pure bending (u = −κxy, v = κ(x² + νy²)/2,
+    θ = κx) of a rectangular unit of two OPT triangles equals the exact ½EIκ²a for every
+    aspect ratio; the CST with a drilling penalty locks (its ratio grows with a/b)."""
+    for ratio in (0.25, 1.0, 4.0, 16.0):
+        X, K = _rectangle_unit(ratio, 1.0, nu)
+        d = np.array([[-x * y, (x * x + nu * y * y) / 2, x] for x, y in X]).ravel()
+        exact = 0.5 * (1.0 / 12.0) * ratio
+        assert abs(0.5 * d @ K @ d / exact - 1.0) < 1e-10
+        if ratio >= 4.0:
+            X, K = _rectangle_unit(ratio, 1.0, nu, "cst")
+            assert 0.5 * d @ K @ d / exact > 1.5
+
+
+def test_opt_membrane_has_exactly_three_rigid_modes():
+    xy = np.array([[0.1, 0.2], [1.3, -0.1], [0.4, 0.9]])
+    K = st.opt_membrane(xy, 2.1e5, 0.3, 0.1)
+    ev = np.linalg.eigvalsh(K)
+    assert np.sum(ev < 1e-10 * ev.max()) == 3 and ev.min() > -1e-10 * ev.max()
+    # rigid in-plane rotation with θz = 1 at every node
+    m = np.array([[-y, x, 1.0] for x, y in xy]).ravel()
+    assert np.abs(K @ m).max() < 1e-10 * np.abs(K).max()

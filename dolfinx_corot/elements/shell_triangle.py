@@ -3,10 +3,23 @@ r"""Flat triangular shell in its element frame: membrane + drilling + DKT bendin
 Local dofs per node, node-major: (u, v, w, θx, θy, θz); the element lies in
 the local x–y plane. Material: isotropic, plane stress, thickness t.
 
-* Membrane: constant-strain triangle, :math:`\mathbf K_m = tA\,\mathbf B_m^T\mathbf D_m\mathbf B_m`.
-* Drilling: :math:`U_d = \tfrac12\,\alpha G t A\sum_i(\theta_{zi} - \omega)^2`, with
-  :math:`\omega = \tfrac12(v_{,x} - u_{,y})` the in-plane rotation of the CST
-  (Hughes & Brezzi 1989 style penalty; rigid in-plane rotations cost nothing).
+* Membrane (default): the optimal ANDES triangle with drilling freedoms, OPT
+  (Felippa 2003, CMAME 192:2125): :math:`\mathbf K_m = \mathbf K_b + \mathbf K_h` on
+  (u, v, θz) per node. The basic stiffness :math:`\mathbf K_b = V^{-1}\mathbf L\mathbf D\mathbf L^T`
+  (V = At) lumps a constant stress field to the nodes, its drilling rows
+  scaled by :math:`\alpha_b = 3/2`; the higher-order stiffness
+  :math:`\mathbf K_h = \tfrac34\beta_0\mathbf T_{\theta u}^T\mathbf K_\theta\mathbf T_{\theta u}`
+  acts on the hierarchical rotations :math:`\tilde\theta_i = \theta_{zi} - \theta_0`
+  (θ0 the CST's rotation), whose natural strains at the corners are
+  :math:`\mathbf Q_i\tilde{\boldsymbol\theta}` with the OPT signature
+  β1..β9 = (1, 2, 1, 0, 1, −1, −1, −1, −2), :math:`\beta_0 = \max(\tfrac12(1-4\nu^2), 0.01)`;
+  :math:`\mathbf K_\theta = V\sum_{m=4}^{6}\mathbf Q_m^T\mathbf T_e^T\mathbf D\mathbf T_e\mathbf Q_m`
+  at the mid-sides. It reproduces the energy of in-plane pure bending of
+  rectangular mesh units exactly, for any aspect ratio and ν (tested).
+* Membrane ``"cst"``: constant-strain triangle, :math:`\mathbf K_m = tA\,\mathbf B_m^T\mathbf D_m\mathbf B_m`,
+  with a drilling penalty :math:`U_d = \tfrac12\,\alpha G t A\sum_i(\theta_{zi} - \omega)^2`,
+  :math:`\omega = \tfrac12(v_{,x} - u_{,y})` the CST's rotation (Hughes & Brezzi 1989
+  style; rigid in-plane rotations cost nothing). It locks in in-plane bending.
 * Bending: the discrete Kirchhoff triangle (Batoz, Bathe & Ho 1980), built as in
   its original derivation: the slopes :math:`\boldsymbol\beta = (w_{,x}, w_{,y})` vary
   quadratically; at the corners :math:`\beta_x = -\theta_y`, :math:`\beta_y = \theta_x`;
@@ -16,16 +29,21 @@ the local x–y plane. Material: isotropic, plane stress, thickness t.
   :math:`\boldsymbol\kappa = (\beta_{x,x}, \beta_{y,y}, \beta_{x,y} + \beta_{y,x})`,
   :math:`\mathbf K_b = \int\mathbf B_b^T\mathbf D_b\mathbf B_b\,dA` by a 3-point rule (exact).
 
-``props = (E, nu, t, alpha, bending)``; ``bending = 0`` gives a membrane:
-the constant-strain triangle alone, no drilling and no bending stiffness.
+``props = (E, nu, t, alpha, bending, opt)``; ``bending = 0`` gives a membrane:
+the constant-strain triangle alone, no drilling and no bending stiffness;
+``opt = 1`` selects the OPT membrane, 0 the CST with drilling penalty α.
 """
 from __future__ import annotations
 
 import numba
 import numpy as np
 
-NPROPS = 5
-E_, NU, T, ALPHA, BENDING = range(NPROPS)
+NPROPS = 6
+E_, NU, T, ALPHA, BENDING, OPT = range(NPROPS)
+
+# OPT signature (Felippa 2003): α_b and β1..β9 (index 0 unused)
+ALPHA_B = 1.5
+_BETA = np.array([0.0, 1.0, 2.0, 1.0, 0.0, 1.0, -1.0, -1.0, -1.0, -2.0])
 
 _GP = np.array([[1.0 / 6.0, 1.0 / 6.0], [2.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 2.0 / 3.0]])
 
@@ -56,6 +74,60 @@ def membrane_B(xy):
         B[2, 2 * i] = c[i]
         B[2, 2 * i + 1] = b[i]
     return B, A2
+
+
+@numba.njit(cache=True)
+def opt_membrane(xy, E, nu, t):
+    """OPT membrane stiffness (9, 9) on (u, v, θz) of nodes 1–3 (counter-clockwise, local x–y)."""
+    x1, y1, x2, y2, x3, y3 = xy[0, 0], xy[0, 1], xy[1, 0], xy[1, 1], xy[2, 0], xy[2, 1]
+    x12, x21, x13, x31, x23, x32 = x1 - x2, x2 - x1, x1 - x3, x3 - x1, x2 - x3, x3 - x2
+    y12, y21, y13, y31, y23, y32 = y1 - y2, y2 - y1, y1 - y3, y3 - y1, y2 - y3, y3 - y2
+    A = 0.5 * (x21 * y31 - x31 * y21)
+    V = A * t
+    D = _plane_stress(E, nu)
+    a6, a3 = ALPHA_B / 6.0, ALPHA_B / 3.0
+    L = np.zeros((9, 3))
+    L[0, 0], L[0, 2] = y23, x32
+    L[1, 1], L[1, 2] = x32, y23
+    L[2, 0], L[2, 1], L[2, 2] = a6 * y23 * (y13 - y21), a6 * x32 * (x31 - x12), a3 * (x31 * y13 - x12 * y21)
+    L[3, 0], L[3, 2] = y31, x13
+    L[4, 1], L[4, 2] = x13, y31
+    L[5, 0], L[5, 1], L[5, 2] = a6 * y31 * (y21 - y32), a6 * x13 * (x12 - x23), a3 * (x12 * y21 - x23 * y32)
+    L[6, 0], L[6, 2] = y12, x21
+    L[7, 1], L[7, 2] = x21, y12
+    L[8, 0], L[8, 1], L[8, 2] = a6 * y12 * (y32 - y13), a6 * x21 * (x23 - x31), a3 * (x23 * y32 - x31 * y13)
+    L *= 0.5 * t
+    K = L @ D @ L.T / V
+    # higher-order stiffness on the hierarchical rotations θ̃ = T_θu d
+    l21, l32, l13 = x21 * x21 + y21 * y21, x32 * x32 + y32 * y32, x13 * x13 + y13 * y13
+    Ttu = np.zeros((3, 9))
+    for r in range(3):
+        Ttu[r, 0], Ttu[r, 1], Ttu[r, 3], Ttu[r, 4], Ttu[r, 6], Ttu[r, 7] = x32, y32, x13, y13, x21, y21
+        Ttu[r, 3 * r + 2] = 4.0 * A
+    Ttu /= 4.0 * A
+    Te = np.empty((3, 3))
+    Te[0, 0], Te[0, 1], Te[0, 2] = y23 * y13 * l21, y31 * y21 * l32, y12 * y32 * l13
+    Te[1, 0], Te[1, 1], Te[1, 2] = x23 * x13 * l21, x31 * x21 * l32, x12 * x32 * l13
+    Te[2, 0] = (y23 * x31 + x32 * y13) * l21
+    Te[2, 1] = (y31 * x12 + x13 * y21) * l32
+    Te[2, 2] = (y12 * x23 + x21 * y32) * l13
+    Te /= 4.0 * A * A
+    b = _BETA
+    inv = np.array([1.0 / l21, 1.0 / l32, 1.0 / l13])
+    idx = np.array([[1, 2, 3, 4, 5, 6, 7, 8, 9], [9, 7, 8, 3, 1, 2, 6, 4, 5], [5, 6, 4, 8, 9, 7, 2, 3, 1]])
+    Q = np.empty((3, 3, 3))
+    for c in range(3):
+        for r in range(3):
+            for k in range(3):
+                Q[c, r, k] = 2.0 * A / 3.0 * b[idx[c, 3 * r + k]] * inv[r]
+    En = Te.T @ D @ Te
+    Kth = np.zeros((3, 3))
+    for c in range(3):
+        Qm = 0.5 * (Q[c] + Q[(c + 1) % 3])
+        Kth += V * (Qm.T @ En @ Qm)
+    beta0 = max(0.5 * (1.0 - 4.0 * nu * nu), 0.01)
+    K += 0.75 * beta0 * (Ttu.T @ Kth @ Ttu)
+    return K
 
 
 @numba.njit(cache=True)
@@ -150,23 +222,31 @@ def local_stiffness(xy, props, K):
     K[:, :] = 0.0
     Bm, A2 = membrane_B(xy)
     A = 0.5 * A2
-    Dm = _plane_stress(E, nu) * t
-    _add_btdb(Bm, Dm, A, np.array([0, 1, 6, 7, 12, 13]), K)
+    if props[BENDING] != 0.0 and props[OPT] != 0.0:
+        Km = opt_membrane(xy, E, nu, t)
+        mdofs = np.array([0, 1, 5, 6, 7, 11, 12, 13, 17])
+        for a in range(9):
+            for b in range(9):
+                K[mdofs[a], mdofs[b]] += Km[a, b]
+    else:
+        Dm = _plane_stress(E, nu) * t
+        _add_btdb(Bm, Dm, A, np.array([0, 1, 6, 7, 12, 13]), K)
     if props[BENDING] == 0.0:
         return
-    # drilling: (θz_i − ω), ω = ½(v,x − u,y) from the CST
-    G = E / (2.0 * (1.0 + nu))
-    kd = alpha * G * t * A
-    om = np.zeros(18)
-    for a in range(3):
-        om[6 * a] = -0.5 * Bm[1, 2 * a + 1]   # −½ ∂N/∂y on u
-        om[6 * a + 1] = 0.5 * Bm[0, 2 * a]    # ½ ∂N/∂x on v
-    for i in range(3):
-        g = -om.copy()
-        g[6 * i + 5] += 1.0
-        for a in range(18):
-            for b in range(18):
-                K[a, b] += kd * g[a] * g[b]
+    if props[OPT] == 0.0:
+        # drilling: (θz_i − ω), ω = ½(v,x − u,y) from the CST
+        G = E / (2.0 * (1.0 + nu))
+        kd = alpha * G * t * A
+        om = np.zeros(18)
+        for a in range(3):
+            om[6 * a] = -0.5 * Bm[1, 2 * a + 1]   # −½ ∂N/∂y on u
+            om[6 * a + 1] = 0.5 * Bm[0, 2 * a]    # ½ ∂N/∂x on v
+        for i in range(3):
+            g = -om.copy()
+            g[6 * i + 5] += 1.0
+            for a in range(18):
+                for b in range(18):
+                    K[a, b] += kd * g[a] * g[b]
     # bending
     Db = _plane_stress(E, nu) * (t * t * t / 12.0)
     bend = np.array([2, 3, 4, 8, 9, 10, 14, 15, 16])

@@ -1,6 +1,8 @@
 """Field output for ParaView: the deformed structure after every converged step (XDMF/HDF5)."""
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 import dolfinx.fem
@@ -17,10 +19,17 @@ class FieldWriter:
     ``displacement`` (gdim components) and ``rotation`` (2D: the angle θ_z; 3D: the
     rotation vector, norm ≤ π). ParaView's "Warp By Vector" shows the deformed
     shape. Close it (or use it in a ``with`` block) to flush the file.
+    A scene whose parts live on several meshes writes one file per mesh,
+    ``path`` with ``_0``, ``_1``, … before the extension.
     """
 
-    def __init__(self, scene, path: str):
-        model = scene.model
+    def __init__(self, scene, path: str, model=None):
+        model = scene.model if model is None else model
+        self.parts = []
+        if hasattr(model, "models"):
+            stem, ext = os.path.splitext(path)
+            self.parts = [FieldWriter(scene, f"{stem}_{i}{ext}", m) for i, m in enumerate(model.models)]
+            return
         mesh = model.V.mesh
         self.model = model
         g = model.gdim
@@ -34,6 +43,10 @@ class FieldWriter:
         self.file.write_mesh(mesh)
 
     def __call__(self, row: dict) -> None:
+        if self.parts:
+            for part in self.parts:
+                part(row)
+            return
         st = self.model.state.x.array.reshape(-1, self.model.state_size)
         g = self.model.gdim
         self.u.x.array.reshape(-1, g)[:] = st[:, :g]
@@ -46,7 +59,10 @@ class FieldWriter:
         self.file.write_function(self.r, t)
 
     def close(self) -> None:
-        self.file.close()
+        for part in self.parts:
+            part.close()
+        if not self.parts:
+            self.file.close()
 
     def __enter__(self):
         return self

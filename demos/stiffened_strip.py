@@ -179,6 +179,10 @@ if comm.rank == 0:
     plt.close(fig)
     with open(os.path.join(out, "convergence.json"), "w") as f:
         json.dump(rows, f, indent=1)
+    with open(os.path.join(out, "convergence.csv"), "w") as f:
+        f.write(",".join(rows[0]) + "\n")
+        for r in rows:
+            f.write(",".join(str(v) for v in r.values()) + "\n")
     with open(os.path.join(out, "tip_values.json"), "w") as f:
         json.dump({"load_factor": lam.tolist(), "ux": u.tolist(), "uz": w.tolist(), "ranks": comm.size}, f)
 

@@ -44,6 +44,8 @@ E_, NU, T, ALPHA, BENDING, OPT = range(NPROPS)
 # OPT signature (Felippa 2003): α_b and β1..β9 (index 0 unused)
 ALPHA_B = 1.5
 _BETA = np.array([0.0, 1.0, 2.0, 1.0, 0.0, 1.0, -1.0, -1.0, -1.0, -2.0])
+# entries of Q1, Q2, Q3 (row-major 3 × 3) as indices into β
+_OPT_INDEX = np.array([[1, 2, 3, 4, 5, 6, 7, 8, 9], [9, 7, 8, 3, 1, 2, 6, 4, 5], [5, 6, 4, 8, 9, 7, 2, 3, 1]])
 
 _GP = np.array([[1.0 / 6.0, 1.0 / 6.0], [2.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 2.0 / 3.0]])
 
@@ -97,37 +99,72 @@ def opt_membrane(xy, E, nu, t):
     L[7, 1], L[7, 2] = x21, y12
     L[8, 0], L[8, 1], L[8, 2] = a6 * y12 * (y32 - y13), a6 * x21 * (x23 - x31), a3 * (x23 * y32 - x31 * y13)
     L *= 0.5 * t
-    K = L @ D @ L.T / V
+    K = np.empty((9, 9))
+    _congruence(L, D, 1.0 / V, K)
     # higher-order stiffness on the hierarchical rotations θ̃ = T_θu d
     l21, l32, l13 = x21 * x21 + y21 * y21, x32 * x32 + y32 * y32, x13 * x13 + y13 * y13
-    Ttu = np.zeros((3, 9))
+    Ttu = np.zeros((9, 3))  # transposed: columns are θ̃_1..3
     for r in range(3):
-        Ttu[r, 0], Ttu[r, 1], Ttu[r, 3], Ttu[r, 4], Ttu[r, 6], Ttu[r, 7] = x32, y32, x13, y13, x21, y21
-        Ttu[r, 3 * r + 2] = 4.0 * A
-    Ttu /= 4.0 * A
+        Ttu[0, r], Ttu[1, r], Ttu[3, r], Ttu[4, r], Ttu[6, r], Ttu[7, r] = x32, y32, x13, y13, x21, y21
+        Ttu[3 * r + 2, r] = 4.0 * A
+    for i in range(9):
+        for r in range(3):
+            Ttu[i, r] /= 4.0 * A
     Te = np.empty((3, 3))
     Te[0, 0], Te[0, 1], Te[0, 2] = y23 * y13 * l21, y31 * y21 * l32, y12 * y32 * l13
     Te[1, 0], Te[1, 1], Te[1, 2] = x23 * x13 * l21, x31 * x21 * l32, x12 * x32 * l13
     Te[2, 0] = (y23 * x31 + x32 * y13) * l21
     Te[2, 1] = (y31 * x12 + x13 * y21) * l32
     Te[2, 2] = (y12 * x23 + x21 * y32) * l13
-    Te /= 4.0 * A * A
+    for i in range(3):
+        for j in range(3):
+            Te[i, j] /= 4.0 * A * A
+    # En = Teᵀ D Te (natural-strain elasticity)
+    TeT = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            TeT[i, j] = Te[j, i]
+    En = np.empty((3, 3))
+    _congruence(TeT, D, 1.0, En)
     b = _BETA
-    inv = np.array([1.0 / l21, 1.0 / l32, 1.0 / l13])
-    idx = np.array([[1, 2, 3, 4, 5, 6, 7, 8, 9], [9, 7, 8, 3, 1, 2, 6, 4, 5], [5, 6, 4, 8, 9, 7, 2, 3, 1]])
+    inv = (1.0 / l21, 1.0 / l32, 1.0 / l13)
     Q = np.empty((3, 3, 3))
     for c in range(3):
         for r in range(3):
             for k in range(3):
-                Q[c, r, k] = 2.0 * A / 3.0 * b[idx[c, 3 * r + k]] * inv[r]
-    En = Te.T @ D @ Te
+                Q[c, r, k] = 2.0 * A / 3.0 * b[_OPT_INDEX[c, 3 * r + k]] * inv[r]
     Kth = np.zeros((3, 3))
+    QmT = np.empty((3, 3))
+    Km = np.empty((3, 3))
     for c in range(3):
-        Qm = 0.5 * (Q[c] + Q[(c + 1) % 3])
-        Kth += V * (Qm.T @ En @ Qm)
+        c2 = (c + 1) % 3
+        for i in range(3):
+            for j in range(3):
+                QmT[i, j] = 0.5 * (Q[c, j, i] + Q[c2, j, i])
+        _congruence(QmT, En, V, Km)
+        for i in range(3):
+            for j in range(3):
+                Kth[i, j] += Km[i, j]
     beta0 = max(0.5 * (1.0 - 4.0 * nu * nu), 0.01)
-    K += 0.75 * beta0 * (Ttu.T @ Kth @ Ttu)
+    Kh = np.empty((9, 9))
+    _congruence(Ttu, Kth, 0.75 * beta0, Kh)
+    for i in range(9):
+        for j in range(9):
+            K[i, j] += Kh[i, j]
     return K
+
+
+@numba.njit(cache=True)
+def _congruence(L, D, scale, out):
+    """out = scale · L D Lᵀ for L (n, 3), D (3, 3) (explicit loops: tiny matrices)."""
+    n = L.shape[0]
+    LD = np.empty((n, 3))
+    for i in range(n):
+        for k in range(3):
+            LD[i, k] = L[i, 0] * D[0, k] + L[i, 1] * D[1, k] + L[i, 2] * D[2, k]
+    for i in range(n):
+        for j in range(n):
+            out[i, j] = scale * (LD[i, 0] * L[j, 0] + LD[i, 1] * L[j, 1] + LD[i, 2] * L[j, 2])
 
 
 @numba.njit(cache=True)

@@ -156,7 +156,9 @@ class System:
             self.model.set_load_factor(load_factor)
             with self.lift.localForm() as f:
                 f.set(0.0)
-            dolfinx.fem.petsc.apply_lifting(self.lift, [self.a], bcs=[self.bcs], x0=[x], scale=1.0)
+            # supports never move (x = 0 there): only prescribed motion has a lifting
+            lifting_bcs = getattr(self.model, "lifting_bcs", self.bcs)
+            dolfinx.fem.petsc.apply_lifting(self.lift, [self.a], bcs=[lifting_bcs], x0=[x], scale=1.0)
             self.lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
             self.b.axpy(1.0, self.lift)
         dolfinx.fem.petsc.set_bc(self.b, self.bcs, x, 1.0)

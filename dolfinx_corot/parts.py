@@ -149,11 +149,15 @@ class LineFrame:
             all_owned = self.V.mesh.comm.allreduce(bool(len(owned) == cmap.size_local), op=MPI.LAND)
             cells = None if all_owned else owned
             self._flag = dolfinx.fem.Constant(self.V.mesh, PETSc.ScalarType(1.0 if self.large_rotations else 0.0))
-            coeffs = [self.state, self.props]
+            coeffs = [self.state, self.props, *self._element_constants()]
             L = assembly.kernel_form(self.V, self.kernels.vector_kernel.address, 1, coeffs, [self._flag], cells)
             a = assembly.kernel_form(self.V, self.kernels.matrix_kernel.address, 2, coeffs, [self._flag], cells)
             self._forms = (L, a)
         return self._forms
+
+    def _element_constants(self) -> list:
+        """Extra per-cell coefficients the kernels read after the properties (none by default)."""
+        return []
 
     def dirichlet_bcs(self) -> list:
         """Supports (zero) and prescribed displacements (λ-scaled values, see :meth:`set_load_factor`)."""
@@ -173,6 +177,7 @@ class LineFrame:
             dofs = dolfinx.fem.locate_dofs_topological((self.V.sub(comp), Vi), 0, vertices)
             bcs.append(dolfinx.fem.dirichletbc(g, dofs, self.V.sub(comp)))
             self._prescribed_values.append((g, dofs[1], value, amplitude))
+        self.lifting_bcs = bcs[len(bcs) - len(self._prescribed):]
         return bcs
 
     @property
@@ -438,6 +443,18 @@ class Shell3D(LineFrame):
         if not (thickness > 0.0 and np.isfinite(thickness)):
             raise ValueError(f"membrane '{where}': thickness = {thickness} must be positive")
         return self.add_elements(where, np.array([E, nu, thickness, 0.0, 0.0, 0.0]), False, "membrane")
+
+    def _element_constants(self) -> list:
+        """Initial frame, local coordinates and local stiffness of every cell (DG0, computed once)."""
+        mesh = self.tmesh.mesh
+        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=kernels_shell.NEDATA)
+        edata = dolfinx.fem.Function(Q, name="element_constants")
+        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 3)]
+        props = self.props.x.array.reshape(-1, self.nprops)[self._prop_blocks]
+        out = np.zeros((len(X), kernels_shell.NEDATA))
+        kernels_shell.element_data_all(X, props, self._owner_of_cell != "", out)
+        edata.x.array.reshape(-1, kernels_shell.NEDATA)[Q.dofmap.list.array] = out
+        return [edata]
 
     def _check_geometry(self, cells, label, props):
         x = self.tmesh.mesh.geometry.x

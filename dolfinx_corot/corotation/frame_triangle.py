@@ -22,8 +22,15 @@ its own axes (a = x₂ − x₁ = (l, 0, 0), b = x₃ − x₁ = (b₁, b₂, 0)
     \omega_1 = \frac{l\,\delta b_3 - b_1\,\delta a_3}{l\,b_2}
 
 (local components of δa = δu₂ − δu₁, δb = δu₃ − δu₁; from δe₁ = ω × e₁ and
-e₂·δe₃ = −ω₁). Then f = Bᵀ f̄. All functions are complex-analytic, so that the
-consistent tangent is obtained by complex-step differentiation.
+e₂·δe₃ = −ω₁). Then f = Bᵀ f̄.
+
+Consistent tangent (:func:`force_and_tangent`), differentiating f = Λᵀ B_lᵀ f̄ with
+f̄ = K̄ d̄: the frame turns (δΛᵀ g = Λᵀ(ω × g) blockwise), Ω changes with the
+side length l and the coordinates (b₁, b₂) of node 3, x̄_a moves, and T⁻¹(θ̄_a)
+changes with θ̄_a (its derivative contracted with the nodal moment, by complex
+step on that 3 × 3 function alone). :func:`basic` and :func:`parts` are
+complex-analytic, so the closed form is checked against complex-step
+differentiation of the internal force (tests).
 """
 from __future__ import annotations
 
@@ -65,12 +72,14 @@ def initial(X, R0, xbar0):
 
 
 @numba.njit(cache=True)
-def basic(X, u, R, R0, xbar0, dbar, B, rotations=True):
-    """Deformational dofs dbar (18,) = (ū_a, θ̄_a) per node and B = ∂d̄/∂d (18, 18).
+def parts(X, u, R, R0, xbar0, rotations=True):
+    """The frame and its first variation in local components (d^l = Λd, Λ = blockdiag(R_rᵀ)).
 
-    X (3, 3) initial and u (3, 3) displacements of the nodes; R (3, 3, 3) nodal
-    rotations; R0, xbar0 from :func:`initial`. rotations=False (membranes):
-    θ̄ = 0 and its rows of B are zero; the nodal rotations are not used.
+    Returns (R_r, l, b₁, b₂, x̄ (3, 3), θ̄ (3, 3), T⁻¹(θ̄_a) (3, 3, 3), Ω (3, 18), B_l (18, 18),
+    d̄ (18,)) with ω = Ω d^l and δd̄ = B_l δd^l. X (3, 3) initial and u (3, 3)
+    displacements of the nodes; R (3, 3, 3) nodal rotations; R0, xbar0 from
+    :func:`initial`. rotations=False (membranes): θ̄ = 0 and its rows of B_l are zero.
+    Complex-analytic in u and R (the dtype of u is used throughout).
     """
     dt = u.dtype
     x = np.empty((3, 3), dtype=dt)
@@ -90,8 +99,10 @@ def basic(X, u, R, R0, xbar0, dbar, B, rotations=True):
             R0c[i, j] = R0[i, j]
     T = np.empty((3, 3), dtype=dt)
     Rb = np.empty((3, 3), dtype=dt)
-    th = np.empty((3, 3), dtype=dt)
     Ra = np.empty((3, 3), dtype=dt)
+    th = np.zeros((3, 3), dtype=dt)
+    Ti = np.zeros((3, 3, 3), dtype=dt)
+    dbar = np.empty(18, dtype=dt)
     for a in range(3):
         if rotations:
             for i in range(3):
@@ -100,26 +111,22 @@ def basic(X, u, R, R0, xbar0, dbar, B, rotations=True):
             _mat3_tn(Rr, Ra, T)
             _mat3(T, R0c, Rb)
             log_rotation(Rb, th[a])
-        else:
-            th[a, :] = 0.0
+            tangent_inverse(th[a], Ti[a])
         for k in range(3):
             dbar[6 * a + k] = xbar[a, k] - xbar0[a, k]
             dbar[6 * a + 3 + k] = th[a, k]
     # Ω (3, 18): local frame spin ω from the local components of δu
-    # (dofs are first expressed in local components: d^l = blockdiag(Rrᵀ) d)
     Om = np.zeros((3, 18), dtype=dt)
-    for k, sgn in ((1, 1.0),):
-        Om[2, 6 * 1 + k] += sgn / l
-        Om[2, 6 * 0 + k] -= sgn / l
-    Om[1, 6 * 1 + 2] -= 1.0 / l
-    Om[1, 6 * 0 + 2] += 1.0 / l
+    Om[2, 7] += 1.0 / l
+    Om[2, 1] -= 1.0 / l
+    Om[1, 8] -= 1.0 / l
+    Om[1, 2] += 1.0 / l
     # ω1 = (l δb3 − b1 δa3)/(l b2), δa = δu2 − δu1, δb = δu3 − δu1
-    Om[0, 6 * 2 + 2] += 1.0 / b2
-    Om[0, 6 * 0 + 2] -= 1.0 / b2
-    Om[0, 6 * 1 + 2] -= b1 / (l * b2)
-    Om[0, 6 * 0 + 2] += b1 / (l * b2)
+    Om[0, 14] += 1.0 / b2
+    Om[0, 2] -= 1.0 / b2
+    Om[0, 8] -= b1 / (l * b2)
+    Om[0, 2] += b1 / (l * b2)
     Bl = np.zeros((18, 18), dtype=dt)
-    Ti = np.empty((3, 3), dtype=dt)
     for a in range(3):
         # δū_a = δu_a − δu_c − ω × x̄_a   (local components)
         for k in range(3):
@@ -136,15 +143,168 @@ def basic(X, u, R, R0, xbar0, dbar, B, rotations=True):
         # δθ̄_a = T⁻¹(θ̄_a)(δw_a − ω)
         if not rotations:
             continue
-        tangent_inverse(th[a], Ti)
+        Tia = Ti[a]
         for r in range(3):
             for col in range(18):
-                Bl[6 * a + 3 + r, col] -= Ti[r, 0] * Om[0, col] + Ti[r, 1] * Om[1, col] + Ti[r, 2] * Om[2, col]
+                Bl[6 * a + 3 + r, col] -= Tia[r, 0] * Om[0, col] + Tia[r, 1] * Om[1, col] + Tia[r, 2] * Om[2, col]
             for k in range(3):
-                Bl[6 * a + 3 + r, 6 * a + 3 + k] += Ti[r, k]
+                Bl[6 * a + 3 + r, 6 * a + 3 + k] += Tia[r, k]
+    return Rr, l, b1, b2, xbar, th, Ti, Om, Bl, dbar
+
+
+@numba.njit(cache=True)
+def basic(X, u, R, R0, xbar0, dbar, B, rotations=True):
+    """Deformational dofs dbar (18,) = (ū_a, θ̄_a) per node and B = ∂d̄/∂d = B_l Λ (18, 18)
+    (see :func:`parts`)."""
+    Rr, l, b1, b2, xbar, th, Ti, Om, Bl, d = parts(X, u, R, R0, xbar0, rotations)
+    for r in range(18):
+        dbar[r] = d[r]
     # columns back to global components: block·Rrᵀ
     for r in range(18):
         for blk in range(6):
             c0 = 3 * blk
             for j in range(3):
                 B[r, c0 + j] = Bl[r, c0] * Rr[j, 0] + Bl[r, c0 + 1] * Rr[j, 1] + Bl[r, c0 + 2] * Rr[j, 2]
+
+
+@numba.njit(cache=True)
+def _dTiT_m(th, m, M):
+    """M (3, 3) = ∂(T⁻¹(θ)ᵀ m)/∂θ by complex-step differentiation of a 3-vector function."""
+    h = 1e-30
+    thc = np.empty(3, dtype=np.complex128)
+    Tc = np.empty((3, 3), dtype=np.complex128)
+    for j in range(3):
+        for k in range(3):
+            thc[k] = th[k]
+        thc[j] += 1j * h
+        tangent_inverse(thc, Tc)
+        for i in range(3):
+            M[i, j] = (Tc[0, i] * m[0] + Tc[1, i] * m[1] + Tc[2, i] * m[2]).imag / h
+
+
+@numba.njit(cache=True)
+def force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K, rotations=True):
+    """f = Bᵀ K̄ d̄ (linear local law f̄ = K̄ d̄) and its consistent tangent K = ∂f/∂d in closed form.
+
+    In local components (d^l = Λd, Λ = blockdiag(R_rᵀ)), with g = B_lᵀ f̄, v = Σ_a(n_a × x̄_a − T_a⁻ᵀ m_a)
+    (n_a, m_a the local nodal forces and moments), ω = Ω d^l the frame spin:
+    K^l = B_lᵀ K̄ B_l − S(g) Ω + ∂(Ωᵀ v)/∂(l, b₁, b₂)·∂(l, b₁, b₂)/∂d^l
+          + Ωᵀ Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) + Σ_a E_aᵀ M_a B_{θ,a},
+    M_a = ∂(T⁻¹(θ̄_a)ᵀ m_a)/∂θ̄_a; then K = Λᵀ K^l Λ and f = Λᵀ g.
+    """
+    Rr, l, b1, b2, xbar, th, Ti, Om, Bl, dbar = parts(X, u, R, R0, xbar0, rotations)
+    fbar = np.empty(18)
+    for i in range(18):
+        acc = 0.0
+        for j in range(18):
+            acc += Kbar[i, j] * dbar[j]
+        fbar[i] = acc
+    g = np.zeros(18)
+    for r in range(18):
+        fr = fbar[r]
+        if fr != 0.0:
+            for i in range(18):
+                g[i] += Bl[r, i] * fr
+    # material part Blᵀ K̄ Bl
+    KB = np.zeros((18, 18))
+    for r in range(18):
+        for j in range(18):
+            acc = 0.0
+            for s in range(18):
+                acc += Kbar[r, s] * Bl[s, j]
+            KB[r, j] = acc
+    Kl = np.zeros((18, 18))
+    for i in range(18):
+        for j in range(18):
+            acc = 0.0
+            for r in range(18):
+                acc += Bl[r, i] * KB[r, j]
+            Kl[i, j] = acc
+    # − S(g) Ω: block b rows 3b..3b+2 get −spin(g_b) Ω
+    for b in range(6):
+        g0, g1, g2 = g[3 * b], g[3 * b + 1], g[3 * b + 2]
+        for col in range(18):
+            o0, o1, o2 = Om[0, col], Om[1, col], Om[2, col]
+            Kl[3 * b + 0, col] -= g1 * o2 - g2 * o1
+            Kl[3 * b + 1, col] -= g2 * o0 - g0 * o2
+            Kl[3 * b + 2, col] -= g0 * o1 - g1 * o0
+    # v and M_a
+    v = np.zeros(3)
+    M = np.zeros((3, 3, 3))
+    for a in range(3):
+        n0, n1, n2 = fbar[6 * a], fbar[6 * a + 1], fbar[6 * a + 2]
+        xa = xbar[a]
+        v[0] += n1 * xa[2] - n2 * xa[1]
+        v[1] += n2 * xa[0] - n0 * xa[2]
+        v[2] += n0 * xa[1] - n1 * xa[0]
+        if rotations:
+            m = fbar[6 * a + 3:6 * a + 6].copy()
+            for i in range(3):
+                v[i] -= Ti[a, 0, i] * m[0] + Ti[a, 1, i] * m[1] + Ti[a, 2, i] * m[2]
+            _dTiT_m(th[a], m, M[a])
+    # ∂(Ωᵀ v)/∂(l, b1, b2) and the variations of l, b1, b2
+    dc_l = np.zeros(18)
+    dc_b1 = np.zeros(18)
+    dc_b2 = np.zeros(18)
+    l2 = l * l
+    dc_l[7] = -v[2] / l2
+    dc_l[1] = v[2] / l2
+    dc_l[8] = v[1] / l2 + b1 * v[0] / (l2 * b2)
+    dc_l[2] = -v[1] / l2 - b1 * v[0] / (l2 * b2)
+    dc_b1[8] = -v[0] / (l * b2)
+    dc_b1[2] = v[0] / (l * b2)
+    dc_b2[8] = b1 * v[0] / (l * b2 * b2)
+    dc_b2[2] = v[0] / (b2 * b2) - b1 * v[0] / (l * b2 * b2)
+    dc_b2[14] = -v[0] / (b2 * b2)
+    dl = np.zeros(18)
+    dl[6] += 1.0
+    dl[0] -= 1.0
+    db1 = np.zeros(18)
+    db2 = np.zeros(18)
+    db1[12] += 1.0
+    db1[0] -= 1.0
+    db2[13] += 1.0
+    db2[1] -= 1.0
+    for j in range(18):
+        db1[j] += b2 * Om[2, j]
+        db2[j] -= b1 * Om[2, j]
+    for i in range(18):
+        if dc_l[i] != 0.0 or dc_b1[i] != 0.0 or dc_b2[i] != 0.0:
+            for j in range(18):
+                Kl[i, j] += dc_l[i] * dl[j] + dc_b1[i] * db1[j] + dc_b2[i] * db2[j]
+    # Ωᵀ δv with δv = Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) δd^l
+    W = np.zeros((3, 18))
+    for a in range(3):
+        n0, n1, n2 = fbar[6 * a], fbar[6 * a + 1], fbar[6 * a + 2]
+        for j in range(18):
+            t0, t1, t2 = Bl[6 * a, j], Bl[6 * a + 1, j], Bl[6 * a + 2, j]
+            W[0, j] += n1 * t2 - n2 * t1
+            W[1, j] += n2 * t0 - n0 * t2
+            W[2, j] += n0 * t1 - n1 * t0
+            if rotations:
+                r0, r1, r2 = Bl[6 * a + 3, j], Bl[6 * a + 4, j], Bl[6 * a + 5, j]
+                for i in range(3):
+                    MB = M[a, i, 0] * r0 + M[a, i, 1] * r1 + M[a, i, 2] * r2
+                    W[i, j] -= MB
+                    Kl[6 * a + 3 + i, j] += MB
+    for i in range(18):
+        o0, o1, o2 = Om[0, i], Om[1, i], Om[2, i]
+        if o0 != 0.0 or o1 != 0.0 or o2 != 0.0:
+            for j in range(18):
+                Kl[i, j] += o0 * W[0, j] + o1 * W[1, j] + o2 * W[2, j]
+    # back to global components: f = Λᵀ g, K = Λᵀ K^l Λ (3 × 3 blocks)
+    for b in range(6):
+        for k in range(3):
+            f[3 * b + k] = Rr[k, 0] * g[3 * b] + Rr[k, 1] * g[3 * b + 1] + Rr[k, 2] * g[3 * b + 2]
+    tmp = np.empty((18, 18))
+    for i in range(18):
+        for bc in range(6):
+            for k in range(3):
+                # (K^l Λ)[i, 3bc+k] = Σ_m K^l[i, 3bc+m] Rrᵀ[m, k] = Σ_m K^l[i, 3bc+m] Rr[k, m]
+                tmp[i, 3 * bc + k] = (Kl[i, 3 * bc] * Rr[k, 0] + Kl[i, 3 * bc + 1] * Rr[k, 1]
+                                      + Kl[i, 3 * bc + 2] * Rr[k, 2])
+    for br in range(6):
+        for k in range(3):
+            for j in range(18):
+                K[3 * br + k, j] = (Rr[k, 0] * tmp[3 * br, j] + Rr[k, 1] * tmp[3 * br + 1, j]
+                                    + Rr[k, 2] * tmp[3 * br + 2, j])

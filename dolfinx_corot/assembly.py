@@ -401,7 +401,7 @@ class CoupledSystem(System):
         comm = self.comm
         sp = dolfinx.cpp.la.SparsityPattern(comm, [lay.imap, lay.imap], [1, 1])
         for m, loc in zip(models, lay.local):
-            cells = m.V.dofmap.list.array.reshape(-1, m.tdim + 1)
+            cells = m.V.dofmap.list.array.reshape(-1, m.nodes_per_cell)
             dofs = loc[(cells[:, :, None] * m.ndof + np.arange(m.ndof)).reshape(len(cells), -1)]
             for row in dofs:
                 sp.insert(row, row)

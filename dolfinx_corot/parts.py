@@ -31,7 +31,9 @@ from .elements import shell_triangle as shell_law
 from .io.mesh import TaggedMesh
 from .kernels import beam3d as kernels3d
 from .kernels import line2d as kernels2d
+from .kernels import membrane_quad as kernels_mq
 from .kernels import shell3d as kernels_shell
+from .elements import membrane_quad as quad_law
 
 
 @dataclass(frozen=True)
@@ -47,6 +49,7 @@ class LineFrame:
     """What 2D and 3D frames and shells share: cells, properties, supports, loads, forms, read-out."""
 
     tdim = 1
+    nodes_per_cell = 2
     gdim: int
     dof_names: tuple[str, ...]
     translations: int           # number of translational dofs per node
@@ -193,7 +196,7 @@ class LineFrame:
         """Local blocks (owned and ghost) that a bending element on this rank touches."""
         nblocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
         flags = np.zeros(nblocks, dtype=bool)
-        dofs = self.V.dofmap.list.array.reshape(-1, self.tdim + 1)
+        dofs = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)
         flags[dofs[self._bending[: len(dofs)]].ravel()] = True
         return flags
 
@@ -406,6 +409,7 @@ class Shell3D(LineFrame):
     per node, rotations multiplicative as in :class:`Frame3D`."""
 
     tdim = 2
+    nodes_per_cell = 3
     gdim = 3
     dof_names = Frame3D.dof_names
     translations = 3
@@ -466,6 +470,64 @@ class Shell3D(LineFrame):
             p = x[g[bad[0], 0]]
             raise ValueError(f"{label}: {len(bad)} triangle(s) of zero area, the first at "
                              f"({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g})")
+
+
+class MembraneQuad(LineFrame):
+    """Four-node co-rotational membranes on a quadrilateral mesh in space; dofs (ux, uy, uz, rx,
+    ry, rz) per node like shells (so that they may share nodes with shells and beams), the
+    rotations of nodes carried by membranes alone fixed."""
+
+    tdim = 2
+    nodes_per_cell = 4
+    gdim = 3
+    dof_names = Frame3D.dof_names
+    translations = 3
+    state_size = kernels3d.NSTATE
+    nprops = quad_law.NPROPS
+    kernels = kernels_mq
+    symmetric_tangent = False
+    update = Frame3D.update
+    extrapolate = Frame3D.extrapolate
+    displacement_vector = Frame3D.displacement_vector
+    _dof_values = staticmethod(Frame3D._dof_values)
+
+    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
+        super().__init__(tmesh, large_rotations)
+        S = dolfinx.fem.VectorFunctionSpace(tmesh.mesh, ("Lagrange", 1), dim=kernels3d.NSTATE)
+        self.state = dolfinx.fem.Function(S, name="state")
+        self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, 3] = 1.0
+        self._disp = dolfinx.fem.Function(self.V, name="displacement")
+
+    def add_membrane(self, where, E: float, nu: float, thickness: float):
+        quad_law.check_props(E, nu, thickness, f"membrane '{where}'")
+        return self.add_elements(where, np.array([E, nu, thickness]), False, "membrane")
+
+    def _element_constants(self) -> list:
+        """Initial frame, local coordinates and Q4 stiffness of every cell (DG0, computed once)."""
+        mesh = self.tmesh.mesh
+        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=kernels_mq.NEDATA)
+        edata = dolfinx.fem.Function(Q, name="element_constants")
+        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 4)]
+        props = self.props.x.array.reshape(-1, self.nprops)[self._prop_blocks]
+        out = np.zeros((len(X), kernels_mq.NEDATA))
+        kernels_mq.element_data_all(X, props, self._owner_of_cell != "", out)
+        edata.x.array.reshape(-1, kernels_mq.NEDATA)[Q.dofmap.list.array] = out
+        return [edata]
+
+    def _check_geometry(self, cells, label, props):
+        x = self.tmesh.mesh.geometry.x
+        g = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 4)[cells][:, kernels_mq.CCW]
+        n = np.cross(x[g[:, 2]] - x[g[:, 0]], x[g[:, 3]] - x[g[:, 1]])
+        # convexity: each corner turns the same way about the element normal
+        for a in range(4):
+            e0 = x[g[:, (a + 1) % 4]] - x[g[:, a]]
+            e1 = x[g[:, (a + 2) % 4]] - x[g[:, (a + 1) % 4]]
+            turn = np.einsum("ij,ij->i", np.cross(e0, e1), n)
+            bad = np.flatnonzero(turn <= 0.0)
+            if len(bad):
+                p = x[g[bad[0], 0]]
+                raise ValueError(f"{label}: {len(bad)} quadrilateral(s) not convex, of zero area or with nodes "
+                                 f"out of order, the first at ({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g})")
 
 
 class Coupled:

@@ -23,7 +23,7 @@ import numpy as np
 
 from .io.mesh import TaggedMesh
 from .materials import Elastic
-from .parts import Coupled, Frame2D, Frame3D, LineFrame, PartRef, Shell3D
+from .parts import Coupled, Frame2D, Frame3D, LineFrame, MembraneQuad, PartRef, Shell3D
 from .sections import Section
 
 KINEMATICS = ("bernoulli", "timoshenko")
@@ -65,7 +65,7 @@ class Scene:
                                      f"{tmesh.mesh.geometry.dim}, the scene's other parts {sorted(gdims)}")
             self._coupled = None
             if tmesh.mesh.topology.dim == 2:
-                frame = Shell3D
+                frame = MembraneQuad if tmesh.mesh.topology.cell_name() == "quadrilateral" else Shell3D
             else:
                 frame = Frame3D if tmesh.mesh.geometry.dim == 3 else Frame2D
             self._models[key] = frame(tmesh, self.large_rotations)
@@ -111,19 +111,25 @@ class Scene:
         if not isinstance(material, Elastic):
             raise TypeError(f"shell '{where}': material must be dc.Elastic, got {type(material).__name__}")
         model = self._model(tmesh)
+        if isinstance(model, MembraneQuad):
+            raise NotImplementedError(f"shell '{where}': shells are triangles; this mesh has quadrilaterals, which "
+                                      "carry membranes (add_membrane). Mesh the shell with triangles "
+                                      "(gmsh: Mesh.RecombineAll = 0)")
         if not isinstance(model, Shell3D):
             raise ValueError(f"shell '{where}': shells need a triangle mesh in 3D (from_gmsh(model, gdim=3))")
         return model.add_shell(where, material.E, material.nu, float(thickness), float(drilling), membrane)
 
     def add_membrane(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float,
                      material: Elastic) -> PartRef:
-        """Co-rotational membrane triangles (in-plane stiffness only) on group ``where`` of a
-        triangle mesh in space; nodes carried by membranes alone have their rotations fixed."""
+        """Co-rotational membranes (in-plane stiffness only) on group ``where`` of a triangle
+        (constant-strain triangles) or quadrilateral (bilinear Q4) mesh in space; nodes
+        carried by membranes alone have their rotations fixed."""
         if not isinstance(material, Elastic):
             raise TypeError(f"membrane '{where}': material must be dc.Elastic, got {type(material).__name__}")
         model = self._model(tmesh)
-        if not isinstance(model, Shell3D):
-            raise ValueError(f"membrane '{where}': membranes need a triangle mesh in 3D (from_gmsh(model, gdim=3))")
+        if not isinstance(model, (Shell3D, MembraneQuad)):
+            raise ValueError(f"membrane '{where}': membranes need a triangle or quadrilateral mesh in 3D "
+                             "(from_gmsh(model, gdim=3))")
         return model.add_membrane(where, material.E, material.nu, float(thickness))
 
     def add_truss(self, tmesh: TaggedMesh, where: str | None = None, *, area: float, material: Elastic,

@@ -231,8 +231,9 @@ def from_arrays(points: np.ndarray, cells: np.ndarray, cell_name: str = "all",
                 comm: MPI.Comm = MPI.COMM_WORLD, node_source: str | None = None) -> TaggedMesh:
     """A :class:`TaggedMesh` built from arrays (frames, lattices and surfaces made in code).
 
-    points: (n, gdim) node coordinates; cells: (m, 2) node indices (lines) or
-    (m, 3) (triangles); all cells form the group ``cell_name``; point_groups:
+    points: (n, gdim) node coordinates; cells: (m, 2) node indices (lines),
+    (m, 3) (triangles) or (m, 4) (quadrilaterals, nodes counter-clockwise); all
+    cells form the group ``cell_name``; point_groups:
     name → node indices. The arrays are read on rank 0 and distributed.
     node_source: meshes built from one array of points with the same
     ``node_source`` share their common nodes when their parts meet in a scene
@@ -245,15 +246,18 @@ def from_arrays(points: np.ndarray, cells: np.ndarray, cell_name: str = "all",
     cells = np.asarray(cells, dtype=np.int64)
     point_groups = point_groups or {}
     nv = cells.shape[1]
-    if nv not in (2, 3):
-        raise ValueError(f"from_arrays: cells must have 2 (lines) or 3 (triangles) nodes, got {nv}")
-    cell = "interval" if nv == 2 else "triangle"
+    if nv not in (2, 3, 4):
+        raise ValueError(f"from_arrays: cells must have 2 (lines), 3 (triangles) or 4 (quadrilaterals) "
+                         f"nodes, got {nv}")
+    cell = {2: "interval", 3: "triangle", 4: "quadrilateral"}[nv]
+    if nv == 4:
+        cells = cells[:, [0, 1, 3, 2]]  # counter-clockwise → DOLFINx's tensor-product vertex order
     domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.Cell(cell, geometric_dimension=gdim), 1))
     if comm.rank == 0:
         msh = dolfinx.mesh.create_mesh(comm, cells, points, domain)
     else:
         msh = dolfinx.mesh.create_mesh(comm, np.empty((0, nv), dtype=np.int64), np.empty((0, gdim)), domain)
-    tdim = nv - 1
+    tdim = 1 if nv == 2 else 2
     cmap = msh.topology.index_map(tdim)
     local = np.arange(cmap.size_local + cmap.num_ghosts, dtype=np.int32)
     tags = dolfinx.mesh.meshtags(msh, tdim, local, np.ones(len(local), dtype=np.int32))

@@ -1,0 +1,67 @@
+r"""Four-node membrane in its element frame (linear, plane stress).
+
+The bilinear quadrilateral (Q4) on the projected initial local coordinates
+(nodes counter-clockwise), :math:`\mathbf K = t\int\mathbf B^T\mathbf D\mathbf B\,dA` by 2 × 2
+Gauss points; dofs (ū, v̄) per node. It passes the patch test on any convex
+quadrilateral; like every Q4 it is stiff in in-plane bending, which
+membranes (fabrics, sheets, cable-net infills) rarely carry.
+
+``props = (E, nu, t)``.
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+NPROPS = 3
+E_, NU, T = range(NPROPS)
+
+_G = 1.0 / np.sqrt(3.0)
+_GAUSS = np.array([[-_G, -_G], [_G, -_G], [_G, _G], [-_G, _G]])
+_NODES = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+
+
+def check_props(E: float, nu: float, t: float, label: str) -> None:
+    if not (np.isfinite(E) and E > 0.0):
+        raise ValueError(f"{label}: Young's modulus E = {E} must be positive")
+    if not (-1.0 < nu < 0.5):
+        raise ValueError(f"{label}: Poisson's ratio nu = {nu} must lie in (-1, 0.5)")
+    if not (np.isfinite(t) and t > 0.0):
+        raise ValueError(f"{label}: thickness = {t} must be positive")
+
+
+@numba.njit(cache=True)
+def local_stiffness(xy, props, K):
+    """K (8, 8) for the local node coordinates xy (4, 2), counter-clockwise."""
+    E, nu, t = props[E_], props[NU], props[T]
+    c = E / (1.0 - nu * nu)
+    D = np.array([[c, c * nu, 0.0], [c * nu, c, 0.0], [0.0, 0.0, c * (1.0 - nu) / 2.0]])
+    K[:, :] = 0.0
+    dN = np.empty((2, 4))
+    B = np.zeros((3, 8))
+    for q in range(4):
+        xi, eta = _GAUSS[q, 0], _GAUSS[q, 1]
+        for a in range(4):
+            dN[0, a] = 0.25 * _NODES[a, 0] * (1.0 + _NODES[a, 1] * eta)
+            dN[1, a] = 0.25 * _NODES[a, 1] * (1.0 + _NODES[a, 0] * xi)
+        J00 = J01 = J10 = J11 = 0.0
+        for a in range(4):
+            J00 += dN[0, a] * xy[a, 0]
+            J01 += dN[0, a] * xy[a, 1]
+            J10 += dN[1, a] * xy[a, 0]
+            J11 += dN[1, a] * xy[a, 1]
+        det = J00 * J11 - J01 * J10
+        for a in range(4):
+            nx = (J11 * dN[0, a] - J01 * dN[1, a]) / det
+            ny = (-J10 * dN[0, a] + J00 * dN[1, a]) / det
+            B[0, 2 * a] = nx
+            B[1, 2 * a + 1] = ny
+            B[2, 2 * a] = ny
+            B[2, 2 * a + 1] = nx
+        w = t * det
+        for i in range(8):
+            for j in range(8):
+                acc = 0.0
+                for r in range(3):
+                    acc += B[r, i] * (D[r, 0] * B[0, j] + D[r, 1] * B[1, j] + D[r, 2] * B[2, j])
+                K[i, j] += w * acc

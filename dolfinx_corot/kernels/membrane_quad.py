@@ -1,0 +1,178 @@
+"""Four-node co-rotational membranes in space: gather ► frame ► law ► scatter.
+
+Nodal state (7 per node, as for shells: displacement and a quaternion that
+membranes leave untouched); element vector (24,) with 6 dofs per node, the
+rotational ones zero (membrane-only nodes have their rotations fixed).
+
+f = Bᵀ K̄ d̄ with the frame of :mod:`dolfinx_corot.corotation.frame_quad`
+and the linear Q4 of :mod:`dolfinx_corot.elements.membrane_quad`; tangent
+K = ∂f/∂u by complex-step differentiation (h = 1e-30) of the translations of
+nodes 1–3, node 4's columns from translation invariance (9 complex
+evaluations). DOLFINx orders a quadrilateral's vertices (0, 0), (1, 0),
+(0, 1), (1, 1); the kernels work counter-clockwise (0, 1, 3, 2).
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from ..corotation import frame_quad as frame
+from ..elements import membrane_quad as law
+from .ufcx import signature
+
+NNODE = 4
+NDOF = 6 * NNODE
+NSTATE = 7
+NEDATA = 9 + 12 + 64           # R0, x̄0, K̄ (computed once per cell)
+NCOEF = NNODE * NSTATE + law.NPROPS + NEDATA
+CCW = np.array([0, 1, 3, 2])   # DOLFINx vertex order → counter-clockwise
+H = 1e-30
+_P0 = NNODE * NSTATE
+_E0 = _P0 + law.NPROPS
+
+
+@numba.njit(cache=True)
+def element_data(X, props, out):
+    """out (NEDATA,) = (R0, x̄0, K̄) of the element with counter-clockwise nodes X (4, 3)."""
+    R0 = np.empty((3, 3))
+    xbar0 = np.empty((4, 3))
+    frame.initial(X, R0, xbar0)
+    K = np.empty((8, 8))
+    law.local_stiffness(np.ascontiguousarray(xbar0[:, :2]), props, K)
+    out[:9] = R0.ravel()
+    out[9:21] = xbar0.ravel()
+    out[21:] = K.ravel()
+
+
+@numba.njit(cache=True)
+def element_data_all(X, props, active, out):
+    """element_data for every active cell; X (n, 4, 3) in DOLFINx vertex order."""
+    for c in range(X.shape[0]):
+        if active[c]:
+            Xc = np.empty((4, 3))
+            for a in range(4):
+                Xc[a] = X[c, CCW[a]]
+            element_data(Xc, props[c], out[c])
+
+
+@numba.njit(cache=True)
+def _force(X, u, xbar0, Kbar, f):
+    """f (12,) = Bᵀ K̄ d̄ on the translations of the counter-clockwise nodes."""
+    dt = u.dtype
+    dbar = np.empty(8, dtype=dt)
+    B = np.empty((8, 12), dtype=dt)
+    frame.basic(X, u, xbar0, dbar, B)
+    fbar = np.empty(8, dtype=dt)
+    for i in range(8):
+        acc = Kbar[i, 0] * dbar[0]
+        for j in range(1, 8):
+            acc += Kbar[i, j] * dbar[j]
+        fbar[i] = acc
+    for i in range(12):
+        acc = B[0, i] * fbar[0]
+        for r in range(1, 8):
+            acc += B[r, i] * fbar[r]
+        f[i] = acc
+
+
+@numba.njit(cache=True)
+def corotational(X, u, xbar0, Kbar, f, K):
+    """X (4, 3), u (4, 3) counter-clockwise → f (12,), K (12, 12) = ∂f/∂u (complex step)."""
+    _force(X, u, xbar0, Kbar, f)
+    uc = u.astype(np.complex128)
+    fc = np.empty(12, dtype=np.complex128)
+    for j in range(9):
+        a, k = divmod(j, 3)
+        up = uc.copy()
+        up[a, k] += 1j * H
+        _force(X, up, xbar0, Kbar, fc)
+        for i in range(12):
+            K[i, j] = fc[i].imag / H
+    for i in range(12):
+        for k in range(3):
+            K[i, 9 + k] = -K[i, k] - K[i, 3 + k] - K[i, 6 + k]
+
+
+@numba.njit(cache=True)
+def linear(X, u, R0, xbar0, Kbar, f, K):
+    """Geometrically linear membrane in its initial frame: K = B₀ᵀ K̄ B₀, f = K u."""
+    z = np.zeros((4, 3))
+    dbar = np.empty(8)
+    B = np.empty((8, 12))
+    frame.basic(X, z, xbar0, dbar, B)
+    K[:, :] = B.T @ Kbar @ B
+    f[:] = K @ u.ravel()
+
+
+@numba.njit(cache=True)
+def evaluate(X, S, props, large_rotations, f24, K24):
+    """Element vector f24 (24,) and matrix K24 (24, 24) in DOLFINx vertex order and dof layout."""
+    Xc = np.empty((4, 3))
+    u = np.empty((4, 3))
+    for a in range(4):
+        Xc[a] = X[CCW[a]]
+        u[a] = S[CCW[a], :3]
+    edata = np.empty(NEDATA)
+    element_data(Xc, props, edata)
+    _evaluate_ccw(Xc, u, edata, large_rotations, True, f24, K24)
+
+
+@numba.njit(cache=True)
+def _evaluate_ccw(Xc, u, edata, large_rotations, tangent, f24, K24):
+    R0 = edata[:9].copy().reshape(3, 3)
+    xbar0 = edata[9:21].copy().reshape(4, 3)
+    Kbar = edata[21:].copy().reshape(8, 8)
+    f = np.empty(12)
+    K = np.empty((12, 12))
+    if large_rotations and not tangent:
+        _force(Xc, u, xbar0, Kbar, f)
+        K[:, :] = 0.0
+    elif large_rotations:
+        corotational(Xc, u, xbar0, Kbar, f, K)
+    else:
+        linear(Xc, u, R0, xbar0, Kbar, f, K)
+    f24[:] = 0.0
+    K24[:, :] = 0.0
+    for a in range(4):
+        A = CCW[a]
+        for k in range(3):
+            f24[6 * A + k] = f[3 * a + k]
+            for b in range(4):
+                Bn = CCW[b]
+                for m in range(3):
+                    K24[6 * A + k, 6 * Bn + m] = K[3 * a + k, 3 * b + m]
+
+
+@numba.njit(cache=True, inline="always")
+def _tabulate(w_, c_, coords_, tangent, f, K):
+    w = numba.carray(w_, (NCOEF,))
+    c = numba.carray(c_, (1,))
+    X = numba.carray(coords_, (4, 3))
+    Xc = np.empty((4, 3))
+    u = np.empty((4, 3))
+    for a in range(4):
+        for k in range(3):
+            Xc[a, k] = X[CCW[a], k]
+            u[a, k] = w[NSTATE * CCW[a] + k]
+    _evaluate_ccw(Xc, u, w[_E0:].copy(), c[0] != 0.0, tangent, f, K)
+
+
+@numba.cfunc(signature, nopython=True, cache=True)
+def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
+    """Element internal-force vector (24,) for a DOLFINx linear form."""
+    b = numba.carray(b_, (NDOF,))
+    f = np.empty(NDOF)
+    K = np.empty((NDOF, NDOF))
+    _tabulate(w_, c_, coords_, False, f, K)
+    for i in range(NDOF):
+        b[i] = f[i]
+
+
+@numba.cfunc(signature, nopython=True, cache=True)
+def matrix_kernel(A_, w_, c_, coords_, entity_local_index, permutation):
+    """Element tangent (24, 24) for a DOLFINx bilinear form."""
+    A = numba.carray(A_, (NDOF, NDOF))
+    f = np.empty(NDOF)
+    K = np.empty((NDOF, NDOF))
+    _tabulate(w_, c_, coords_, True, f, K)
+    A[:, :] = K

@@ -108,16 +108,28 @@ class LineFrame:
         gdofs = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 2)[cells]
         return x[gdofs[:, 0]], x[gdofs[:, 1]] - x[gdofs[:, 0]]
 
+    def _refuse(self, cells: np.ndarray, bad: np.ndarray, points: np.ndarray, message: str) -> None:
+        """Raise ValueError(message) on every rank if any rank found bad cells.
+
+        cells: the local cells checked; bad: indices into cells of the bad ones;
+        points: (len(cells), ≥gdim) a point of each cell for the message, which
+        may use {n} (number of bad cells, owned ones counted once) and {at}.
+        """
+        owned = cells[bad] < self.tmesh.mesh.topology.index_map(self.tdim).size_local
+        first = points[bad[0], : self.gdim].tolist() if len(bad) else None
+        found = self.comm.allgather((int(np.sum(owned)), first))
+        total = sum(n for n, _ in found)
+        if total or any(f is not None for _, f in found):
+            at = next(f for _, f in found if f is not None)
+            raise ValueError(message.format(n=max(total, 1), at="(" + ", ".join(f"{c:.6g}" for c in at) + ")"))
+
     def _check_geometry(self, cells: np.ndarray, label: str, props: np.ndarray) -> None:
         start, d = self._element_vectors(cells)
         lengths = np.linalg.norm(d, axis=1)
         x = self.tmesh.mesh.geometry.x
         scale = max(float(np.ptp(x, axis=0).max()) if len(x) else 1.0, 1e-300)
         bad = np.flatnonzero(lengths <= 1e-10 * scale)
-        if len(bad):
-            p = start[bad[0], : self.gdim]
-            raise ValueError(f"{label}: {len(bad)} element(s) of zero length, the first at "
-                             f"({', '.join(f'{c:.6g}' for c in p)})")
+        self._refuse(cells, bad, start, f"{label}: {{n}} element(s) of zero length, the first at {{at}}")
 
     def fix(self, where: str, dofs: tuple[int, ...]) -> None:
         self._bcs.append((self.tmesh.vertices(where), dofs))
@@ -378,9 +390,9 @@ class Frame3D(LineFrame):
         v = props[-3:]
         c = np.abs(d @ v) / (np.linalg.norm(d, axis=1) * np.linalg.norm(v))
         bad = np.flatnonzero(c > 1.0 - 1e-8)
-        if len(bad):
-            raise ValueError(f"{label}: the orientation vector {v.tolist()} is parallel to {len(bad)} element(s); "
-                             "choose one that fixes the local y axis")
+        start, _ = self._element_vectors(cells)
+        self._refuse(cells, bad, start, f"{label}: the orientation vector {v.tolist()} is parallel to {{n}} "
+                     "element(s), the first at {at}; choose one that fixes the local y axis")
 
     def update(self, dx: PETSc.Vec) -> None:
         """u ← u + du; q ← exp(dw)∘q (multiplicative, spatial) on owned nodes; ghosts from their owners."""
@@ -466,10 +478,7 @@ class Shell3D(LineFrame):
         area = 0.5 * np.linalg.norm(np.cross(x[g[:, 1]] - x[g[:, 0]], x[g[:, 2]] - x[g[:, 0]]), axis=1)
         scale = max(float(np.ptp(x, axis=0).max()) if len(x) else 1.0, 1e-300)
         bad = np.flatnonzero(area <= 1e-10 * scale**2)
-        if len(bad):
-            p = x[g[bad[0], 0]]
-            raise ValueError(f"{label}: {len(bad)} triangle(s) of zero area, the first at "
-                             f"({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g})")
+        self._refuse(cells, bad, x[g[:, 0]], f"{label}: {{n}} triangle(s) of zero area, the first at {{at}}")
 
 
 class MembraneQuad(LineFrame):
@@ -519,15 +528,13 @@ class MembraneQuad(LineFrame):
         g = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 4)[cells][:, kernels_mq.CCW]
         n = np.cross(x[g[:, 2]] - x[g[:, 0]], x[g[:, 3]] - x[g[:, 1]])
         # convexity: each corner turns the same way about the element normal
+        ok = np.ones(len(g), dtype=bool)
         for a in range(4):
             e0 = x[g[:, (a + 1) % 4]] - x[g[:, a]]
             e1 = x[g[:, (a + 2) % 4]] - x[g[:, (a + 1) % 4]]
-            turn = np.einsum("ij,ij->i", np.cross(e0, e1), n)
-            bad = np.flatnonzero(turn <= 0.0)
-            if len(bad):
-                p = x[g[bad[0], 0]]
-                raise ValueError(f"{label}: {len(bad)} quadrilateral(s) not convex, of zero area or with nodes "
-                                 f"out of order, the first at ({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g})")
+            ok &= np.einsum("ij,ij->i", np.cross(e0, e1), n) > 0.0
+        self._refuse(cells, np.flatnonzero(~ok), x[g[:, 0]], f"{label}: {{n}} quadrilateral(s) not convex, of zero "
+                     "area or with nodes out of order, the first at {at}")
 
 
 class Coupled:

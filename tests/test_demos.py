@@ -66,3 +66,11 @@ def test_restart_under_mpi_matches_serial(tmp_path):
         assert r["diff"] < 1e-12
     assert abs(runs[1]["load_factor"] - runs[2]["load_factor"]) < 1e-8
     np.testing.assert_allclose(runs[2]["tip"], runs[1]["tip"], atol=1e-8)
+
+
+@pytest.mark.mpi
+def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
+    """Parts on several meshes (shared nodes across ranks) and quadrilateral membranes on 2 ranks."""
+    out = _run(["mpirun", "-n", "2", sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--color=no",
+                "tests/test_coupled.py", "tests/test_membrane_quad.py"], tmp_path)
+    assert out.count(" passed") == 2 and "failed" not in out

@@ -7,7 +7,7 @@ per-step history.
 from . import rotations
 from .amplitudes import Amplitude
 from .io.mesh import GroupNotFoundError, TaggedMesh, from_gmsh
-from .materials import Elastic
+from .materials import Elastic, NeoHookean, SaintVenantKirchhoff
 from .result import History, Result
 from .scene import Scene
 from .sections import Circle, Rectangle, Section
@@ -16,5 +16,5 @@ from .solvers import ArcLength, ConvergenceError, LoadControl, NewtonOptions, so
 __version__ = "0.1.0"
 
 __all__ = ["Amplitude", "ArcLength", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
-           "NewtonOptions", "Rectangle", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
+           "NeoHookean", "NewtonOptions", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
            "rotations", "solve"]

@@ -93,7 +93,8 @@ class System:
     (e.g. ``-dc_newton_pc_type lu``).
     """
 
-    def __init__(self, model: Model, options_prefix: str = "dc_newton_", symmetric: bool | None = None):
+    def __init__(self, model: Model, options_prefix: str = "dc_newton_", symmetric: bool | None = None,
+                 solver: str = "direct"):
         self.model = model
         self.comm = model.comm
         self._build()
@@ -114,10 +115,18 @@ class System:
             symmetric = getattr(model, "symmetric_tangent", True)
         self.ksp = PETSc.KSP().create(self.comm)
         self.ksp.setOptionsPrefix(options_prefix)
-        self.ksp.setType("preonly")
         pc = self.ksp.getPC()
-        pc.setType("cholesky" if symmetric else "lu")
-        pc.setFactorSolverType("mumps")
+        if solver == "iterative":
+            # CG + smoothed-aggregation AMG with the rigid-body near-nullspace (continua)
+            self.ksp.setType("cg" if symmetric else "gmres")
+            pc.setType("gamg")
+            self.ksp.setTolerances(rtol=1e-10, atol=1e-50, max_it=2000)
+            self._nullspace = model.near_nullspace()
+            self.A.setNearNullSpace(self._nullspace)
+        else:
+            self.ksp.setType("preonly")
+            pc.setType("cholesky" if symmetric else "lu")
+            pc.setFactorSolverType("mumps")
         self.ksp.setFromOptions()
         self.ksp.setOperators(self.A)
         self._mumps = self.ksp.getType() == "preonly" and pc.getType() in ("lu", "cholesky") \
@@ -561,6 +570,16 @@ class CoupledSystem(System):
             obj.destroy()
 
 
-def make_system(model, **kwargs) -> System:
-    """The :class:`System` of a model: DOLFINx's layout for one mesh, a :class:`CoupledSystem` for several."""
-    return CoupledSystem(model, **kwargs) if hasattr(model, "models") else System(model, **kwargs)
+def make_system(model, solver: str = "auto", **kwargs) -> System:
+    """The :class:`System` of a model: DOLFINx's layout for one mesh, a :class:`CoupledSystem` for several.
+
+    solver: 'direct' (MUMPS), 'iterative' (CG + GAMG with the rigid-body near-nullspace) or
+    'auto': iterative for a continuum alone, direct for structures and coupled parts.
+    """
+    if solver == "auto":
+        solver = "iterative" if hasattr(model, "near_nullspace") else "direct"
+    if solver == "iterative" and not hasattr(model, "near_nullspace"):
+        raise NotImplementedError("the iterative solver (CG + GAMG) is for continua alone; structures and coupled "
+                                  "parts use the direct solver")
+    cls = CoupledSystem if hasattr(model, "models") else System
+    return cls(model, solver=solver, **kwargs)

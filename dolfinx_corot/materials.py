@@ -25,3 +25,16 @@ class Elastic:
     def G(self) -> float:
         """Shear modulus E / (2 (1 + ν))."""
         return self.E / (2.0 * (1.0 + self.nu))
+
+
+@dataclass(frozen=True)
+class SaintVenantKirchhoff(Elastic):
+    """Hyperelastic St Venant–Kirchhoff material for large-deformation continua:
+    S = λ tr(E) I + 2μ E with the Green–Lagrange strain E (Lamé constants from E, ν).
+    Exact for large rotations, meant for moderate strains."""
+
+
+@dataclass(frozen=True)
+class NeoHookean(Elastic):
+    """Compressible neo-Hookean material: ψ = μ/2 (I₁ − 3 − 2 ln J) + λ/2 (ln J)²
+    (Lamé constants from E, ν at small strain)."""

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .continuum.solid import Solid
 from .io.mesh import TaggedMesh
 from .materials import Elastic
 from .parts import Coupled, Frame2D, Frame3D, LineFrame, MembraneQuad, PartRef, Shell3D
@@ -44,7 +45,15 @@ class Scene:
     True; geometrically linear ones if False.
     """
 
-    def __init__(self, large_rotations: bool = True):
+    LINEAR_SOLVERS = ("auto", "direct", "iterative")
+
+    def __init__(self, large_rotations: bool = True, linear_solver: str = "auto"):
+        """linear_solver: 'auto' (CG + algebraic multigrid for a scene of continua only, MUMPS
+        otherwise), 'direct' (MUMPS) or 'iterative'; PETSc options with the prefix
+        ``dc_newton_`` override either (e.g. ``-dc_newton_ksp_rtol 1e-12``)."""
+        if linear_solver not in self.LINEAR_SOLVERS:
+            raise ValueError(f"linear_solver '{linear_solver}' is not one of {self.LINEAR_SOLVERS}")
+        self.linear_solver = linear_solver
         self.large_rotations = bool(large_rotations)
         self._models: dict[int, LineFrame] = {}
         self._coupled: Coupled | None = None
@@ -53,7 +62,7 @@ class Scene:
         self._prescribed = 0
 
     # -- parts -----------------------------------------------------------------
-    def _model(self, tmesh: TaggedMesh) -> LineFrame:
+    def _model(self, tmesh: TaggedMesh, solid_degree: int | None = None) -> LineFrame:
         if not isinstance(tmesh, TaggedMesh):
             raise TypeError(f"expected a TaggedMesh from dolfinx_corot.io.from_gmsh, got {type(tmesh).__name__}")
         key = id(tmesh)
@@ -64,12 +73,37 @@ class Scene:
                     raise ValueError(f"parts of one scene live in one space: this mesh has gdim "
                                      f"{tmesh.mesh.geometry.dim}, the scene's other parts {sorted(gdims)}")
             self._coupled = None
+            if solid_degree is not None:
+                self._models[key] = Solid(tmesh, solid_degree, self.large_rotations)
+                return self._models[key]
+            if tmesh.mesh.topology.dim == tmesh.mesh.geometry.dim and tmesh.mesh.topology.dim > 1:
+                raise ValueError("this mesh fills its space (a continuum): use add_solid; structural parts need "
+                                 "lines or surfaces in space")
             if tmesh.mesh.topology.dim == 2:
                 frame = MembraneQuad if tmesh.mesh.topology.cell_name() == "quadrilateral" else Shell3D
             else:
                 frame = Frame3D if tmesh.mesh.geometry.dim == 3 else Frame2D
             self._models[key] = frame(tmesh, self.large_rotations)
-        return self._models[key]
+        model = self._models[key]
+        if (solid_degree is not None) != isinstance(model, Solid):
+            raise ValueError("a mesh carries either a solid or structural parts, not both")
+        if solid_degree is not None and model.degree != solid_degree:
+            raise ValueError(f"the solid on this mesh has degree {model.degree}; all its regions share it")
+        return model
+
+    def add_solid(self, tmesh: TaggedMesh, where: str | None = None, *, material: Elastic,
+                  degree: int = 2) -> PartRef:
+        """Large-deformation continuum (plane strain in 2D, or 3D) on the cells of group ``where``
+        (all cells if None) of a mesh that fills its space; Lagrange elements of ``degree`` 1
+        or 2 on triangles, quadrilaterals, tetrahedra or hexahedra.
+
+        material: dc.SaintVenantKirchhoff or dc.NeoHookean (dc.Elastic: St Venant–Kirchhoff).
+        A named region given after the whole mesh takes its cells over: that is how one
+        element or a zone is weakened as an imperfection.
+        """
+        if not isinstance(material, Elastic):
+            raise TypeError(f"solid '{where}': material must be a dc material, got {type(material).__name__}")
+        return self._model(tmesh, solid_degree=int(degree)).add_region(where, material)
 
     def add_beam(self, tmesh: TaggedMesh, where: str | None = None, *, section: Section,
                  material: Elastic, kinematics: str = "bernoulli", orientation=(0.0, 0.0, 1.0)) -> PartRef:
@@ -183,14 +217,32 @@ class Scene:
             model.prescribe(where, names.index(dof), float(value), amplitude)
         self._prescribed += 1
 
-    def load(self, part: PartRef, where: str, force=None, moment=None, amplitude=None) -> None:
+    def load(self, part: PartRef, where: str, force=None, moment=None, amplitude=None, traction=None) -> None:
         """Dead point force and moment at each node of ``where``, scaled by the load factor λ
         or, with an ``amplitude`` (:class:`dolfinx_corot.Amplitude`), by amplitude(λ).
 
         2D: force (fx, fy), moment mz (a number). 3D: force (fx, fy, fz),
-        moment (mx, my, mz), a fixed spatial vector.
+        moment (mx, my, mz), a fixed spatial vector. Solids: ``traction`` (per unit
+        reference area, a facet group) or ``force`` at each node of the group.
         """
         g = part.model.gdim
+        if isinstance(part.model, Solid):
+            if moment is not None:
+                raise ValueError(f"load '{where}': solids carry no moments")
+            for name, value in (("force", force), ("traction", traction)):
+                if value is None:
+                    continue
+                value = np.atleast_1d(np.asarray(value, dtype=float))
+                if value.shape != (g,) or not np.all(np.isfinite(value)):
+                    raise ValueError(f"load '{where}': {name} must be {g} finite numbers, got {value.tolist()}")
+                if name == "force":
+                    part.model.add_load(where, value, amplitude)
+                else:
+                    part.model.add_traction(where, value, amplitude)
+                self._loads += 1
+            return
+        if traction is not None:
+            raise ValueError(f"load '{where}': tractions act on solids; structures take forces and moments")
         nm = 1 if g == 2 else 3
         force = np.zeros(g) if force is None else np.atleast_1d(np.asarray(force, dtype=float))
         moment = np.zeros(nm) if moment is None else np.atleast_1d(np.asarray(moment, dtype=float))
@@ -200,6 +252,17 @@ class Scene:
                              f"{'a number' if nm == 1 else '3 numbers'}; got force={force.tolist()}, "
                              f"moment={moment.tolist()}")
         part.model.add_load(where, np.concatenate([force, moment]), amplitude)
+        self._loads += 1
+
+    def gravity(self, part: PartRef, acceleration, density: float, where: str | None = None,
+                amplitude=None) -> None:
+        """Body force ρ·g per unit reference volume on a solid (cells of ``where``, all if None)."""
+        if not isinstance(part.model, Solid):
+            raise ValueError("gravity acts on solids (structural self-weight: point loads)")
+        acc = np.atleast_1d(np.asarray(acceleration, dtype=float))
+        if acc.shape != (part.model.gdim,) or not (np.isfinite(density) and density >= 0.0):
+            raise ValueError(f"gravity: acceleration must be {part.model.gdim} numbers and density ≥ 0")
+        part.model.add_body_force(where, density * acc, amplitude)
         self._loads += 1
 
     def monitor(self, name: str, part: PartRef, where: str) -> None:
@@ -232,11 +295,16 @@ class Scene:
         """What will be assembled, in words."""
         out = []
         for m in self._models.values():
+            if isinstance(m, Solid):
+                law = m.law.__name__ if self.large_rotations else "small-strain elastic"
+                kind = "plane strain" if m.gdim == 2 else "3D"
+                out.append(f"continuum ({law}, {kind}, degree {m.degree} on {m.tmesh.mesh.topology.cell_name()}s)")
+                continue
             kinds = sorted({p.kind for p in m.parts})
             frame = "co-rotational" if self.large_rotations else "geometrically linear"
             out.append(f"{' and '.join(kinds)} elements ({frame}, {m.gdim}D)")
         if self._loads:
-            out.append("point loads (dead)")
+            out.append("dead loads")
         if self._prescribed:
             out.append("prescribed displacements")
         return out

@@ -46,6 +46,37 @@ class TaggedMesh:
     points: dict[str, np.ndarray] = field(default_factory=dict)
     node_ids: dict[str, np.ndarray] = field(default_factory=dict)
     node_source: str = ""
+    facet_tags: dolfinx.mesh.MeshTagsMetaClass | None = None
+    extra_cells: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def add_cell_group(self, name: str, where) -> None:
+        """A group of cells chosen by their midpoints: ``where(x)`` takes (3, n) coordinates and
+        returns n booleans (e.g. the one element weakened as an imperfection). Cells may
+        belong to it and to their gmsh group at once."""
+        if name in self.groups:
+            raise ValueError(f"group '{name}' exists already")
+        tdim = self.tdim
+        cmap = self.mesh.topology.index_map(tdim)
+        cells = np.arange(cmap.size_local + cmap.num_ghosts, dtype=np.int32)
+        mid = dolfinx.mesh.compute_midpoints(self.mesh, tdim, cells)
+        picked = cells[np.asarray(where(mid.T), dtype=bool)]
+        if self.mesh.comm.allreduce(int(np.sum(picked < cmap.size_local))) == 0:
+            raise ValueError(f"cell group '{name}': no cell's midpoint satisfies the condition")
+        self.extra_cells[name] = picked
+        self.groups[name] = (tdim, -1)
+
+    def add_point_group(self, name: str, points) -> None:
+        """A group of nodes located by their coordinates (n, 3) (e.g. a loaded point)."""
+        if name in self.groups:
+            raise ValueError(f"group '{name}' exists already")
+        pts = np.atleast_2d(np.asarray(points, dtype=float))
+        full = np.zeros((len(pts), 3))
+        full[:, : pts.shape[1]] = pts
+        self.points[name] = full
+        self.groups[name] = (0, -1)
+        if self.mesh.comm.allreduce(len(self.vertices(name))) == 0:
+            del self.points[name], self.groups[name]
+            raise ValueError(f"point group '{name}': no node at {pts.tolist()}")
 
     @property
     def tdim(self) -> int:
@@ -67,7 +98,16 @@ class TaggedMesh:
         if dim != tdim:
             raise ValueError(f"physical group '{name}' has dimension {dim}; a group of cells "
                              f"(dimension {tdim}) is needed here")
+        if name in self.extra_cells:
+            return self.extra_cells[name]
         return self.cell_tags.indices[self.cell_tags.values == tag]
+
+    def facets(self, name: str) -> np.ndarray | None:
+        """Local facets of group ``name`` if it is a group of facets with facet tags (else None)."""
+        dim, tag = self._check(name)
+        if dim != self.tdim - 1 or self.facet_tags is None or self.tdim < 2:
+            return None
+        return self.facet_tags.indices[self.facet_tags.values == tag]
 
     def vertices(self, name: str) -> np.ndarray:
         """Local vertex indices (owned and ghost) of the nodes of group ``name`` (any dim)."""
@@ -174,8 +214,9 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
     source = comm.bcast(source, root=rank)
     tdim = comm.bcast(tdim, root=rank)
     top = max(d for d, _ in groups.values())
+    facet_tags = None
     if tdim == top:
-        msh, cell_tags, _ = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+        msh, cell_tags, facet_tags = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
     else:
         msh, cell_tags = _lower_dimensional_mesh(model, comm, rank, gdim, tdim)
     ncells_local = msh.topology.index_map(tdim).size_local
@@ -183,7 +224,7 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
     ntagged = comm.allreduce(int(np.sum(cell_tags.indices < ncells_local)), op=MPI.SUM)
     if ntagged != ncells:
         raise ValueError(f"{ncells - ntagged} of {ncells} cells have no physical group")
-    return TaggedMesh(msh, cell_tags, groups, points, node_source=source)
+    return TaggedMesh(msh, cell_tags, groups, points, node_source=source, facet_tags=facet_tags)
 
 
 def _lower_dimensional_mesh(model, comm: MPI.Comm, rank: int, gdim: int, tdim: int):

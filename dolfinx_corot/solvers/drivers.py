@@ -363,7 +363,7 @@ def solve(scene, driver, system: System | None = None, on_step=None, checkpoint:
     """
     own_system = system is None
     if own_system:
-        system = make_system(scene.model)
+        system = make_system(scene.model, solver=getattr(scene, "linear_solver", "auto"))
     try:
         return driver.run(_Run(scene, system, on_step, checkpoint), restart)
     finally:

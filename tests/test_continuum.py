@@ -1,0 +1,199 @@
+"""Large-deformation continua (UFL): exact homogeneous states, tangent, solver choice, loads, bad input."""
+import gmsh
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import dolfinx_corot as dc
+from dolfinx_corot.assembly import make_system
+
+comm = MPI.COMM_WORLD
+L, H, E = 2.0, 1.0, 100.0
+
+
+def _rectangle(nx, ny, quads):
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        g = gmsh.model.geo
+        p = [g.addPoint(x, y, 0.0) for x, y in ((0, 0), (L, 0), (L, H), (0, H))]
+        lines = [g.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
+        s = g.addPlaneSurface([g.addCurveLoop(lines)])
+        for line, n in zip(lines, (nx, ny, nx, ny)):
+            g.mesh.setTransfiniteCurve(line, n + 1)
+        g.mesh.setTransfiniteSurface(s)
+        if quads:
+            g.mesh.setRecombine(2, s)
+        g.synchronize()
+        for dim, tags, name in ((2, [s], "block"), (1, [lines[3]], "left"), (1, [lines[0]], "bottom"),
+                                (1, [lines[1]], "right"), (1, [lines[2]], "top")):
+            tag = gmsh.model.addPhysicalGroup(dim, tags)
+            gmsh.model.setPhysicalName(dim, tag, name)
+        gmsh.model.mesh.generate(2)
+    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm
+
+
+def _box(n, hexes):
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.occ.addBox(0, 0, 0, L, H, H)
+        gmsh.model.occ.synchronize()
+        for c in gmsh.model.getEntities(1):
+            gmsh.model.mesh.setTransfiniteCurve(c[1], n + 1)
+        for s in gmsh.model.getEntities(2):
+            gmsh.model.mesh.setTransfiniteSurface(s[1])
+            if hexes:
+                gmsh.model.mesh.setRecombine(2, s[1])
+        gmsh.model.mesh.setTransfiniteVolume(1)
+        names = {}
+        for _, s in gmsh.model.getEntities(2):
+            c = gmsh.model.occ.getCenterOfMass(2, s)
+            for k, axis in enumerate("xyz"):
+                if abs(c[k]) < 1e-9:
+                    names[s] = f"{axis}0"
+                if axis == "x" and abs(c[0] - L) < 1e-9:
+                    names[s] = "x1"
+        gmsh.model.addPhysicalGroup(3, [1], 1)
+        gmsh.model.setPhysicalName(3, 1, "block")
+        for k, (s, name) in enumerate(sorted(names.items()), start=2):
+            gmsh.model.addPhysicalGroup(2, [s], k)
+            gmsh.model.setPhysicalName(2, k, name)
+        gmsh.model.mesh.generate(3)
+    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=3, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm
+
+
+def _uniaxial_exact(material, s):
+    """First Piola stress P_xx of uniaxial stretch s with free lateral faces (ν = 0: no lateral strain)."""
+    if isinstance(material, dc.NeoHookean):
+        return material.E / 2 * (s - 1 / s)
+    return s * material.E * 0.5 * (s * s - 1)
+
+
+@pytest.mark.parametrize("material", [dc.SaintVenantKirchhoff(E, 0.0), dc.NeoHookean(E, 0.0)],
+                         ids=["svk", "neo-hookean"])
+@pytest.mark.parametrize("quads,degree", [(False, 1), (False, 2), (True, 1), (True, 2)])
+def test_uniaxial_stretch_reaction_is_exact_in_plane_strain(material, quads, degree):
+    """Stretch by 25 %, sides free (ν = 0): the reaction is P_xx(s) H for any element."""
+    tm = _rectangle(4, 2, quads)
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=material, degree=degree)
+    sc.fix(b, "left", dofs=("ux",))
+    sc.fix(b, "bottom", dofs=("uy",))
+    sc.prescribe(b, "right", ux=0.5)
+    sc.monitor_reaction("right", b, "right")
+    res = dc.solve(sc, dc.LoadControl(steps=2))
+    exact = _uniaxial_exact(material, 1.25) * H
+    assert abs(res.history.column("right_Fx")[-1] - exact) < 1e-8 * exact
+
+
+@pytest.mark.parametrize("hexes", [False, True], ids=["tets", "hexes"])
+def test_uniaxial_stretch_in_3d_with_poisson(hexes):
+    """3D St Venant–Kirchhoff bar with ν = 0.3 stretched by 20 %, symmetry planes x0/y0/z0: the
+    lateral stretch t solves S_yy = 0 and the reaction is s·S_xx·t² (exact for P1 and P2)."""
+    nu, s = 0.3, 1.2
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    Exx = 0.5 * (s * s - 1)
+    Eyy = -lam * Exx / (2 * (lam + mu))          # S_yy = λ(Exx + 2Eyy) + 2μ Eyy = 0
+    t = np.sqrt(1 + 2 * Eyy)
+    Sxx = lam * (Exx + 2 * Eyy) + 2 * mu * Exx
+    tm = _box(2, hexes)
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, nu), degree=2)
+    for face, dof in (("x0", "ux"), ("y0", "uy"), ("z0", "uz")):
+        sc.fix(b, face, dofs=(dof,))
+    sc.prescribe(b, "x1", ux=(s - 1) * L)
+    sc.monitor_reaction("x1", b, "x1")
+    res = dc.solve(sc, dc.LoadControl(steps=2))
+    exact = s * Sxx * H * H           # P_xx = F_xx S_xx on the reference area H²
+    assert abs(res.history.column("x1_Fx")[-1] - exact) < 1e-7 * exact
+    assert "continuum (SaintVenantKirchhoff, 3D, degree 2" in sc.effects()[0]
+    assert t < 1.0
+
+
+@pytest.mark.skipif(comm.size > 1, reason="dense FD check of the element forms: serial")
+@pytest.mark.parametrize("material", [dc.SaintVenantKirchhoff(E, 0.3), dc.NeoHookean(E, 0.3)],
+                         ids=["svk", "neo-hookean"])
+def test_tangent_matches_finite_differences_of_the_residual(material):
+    tm = _rectangle(2, 2, True)
+    sc = dc.Scene(linear_solver="direct")
+    b = sc.add_solid(tm, material=material, degree=2)
+    sc.fix(b, "left")
+    system = make_system(sc.model, solver="direct")
+    model = sc.model
+    rng = np.random.default_rng(0)
+    model.state.x.array[:] = 0.02 * rng.normal(size=model.state.x.array.size)  # |∇u| ≈ 0.1
+    model.state.x.scatter_forward()
+    system.residual(0.0)
+    system.jacobian()
+    K = system.A.convert("dense").getDenseArray()
+    x0 = model.state.x.array.copy()
+    n = x0.size
+    Kfd = np.empty((n, n))
+    h = 1e-6
+    for j in range(n):
+        for sign in (1, -1):
+            model.state.x.array[:] = x0
+            model.state.x.array[j] += sign * h
+            system.residual(0.0)
+            r = system.b.array.copy()  # λ f_ext − f_int (constrained rows: x̄ − x)
+            if sign == 1:
+                rp = r
+        Kfd[:, j] = -(rp - r) / (2 * h)
+    model.state.x.array[:] = x0
+    free = np.setdiff1d(np.arange(n), np.concatenate([bc.dof_indices()[0] for bc in system.bcs]))
+    sub = np.ix_(free, free)
+    assert np.abs(K[sub] - Kfd[sub]).max() < 1e-6 * np.abs(K[sub]).max()
+    system.destroy()
+
+
+def test_linear_solver_is_chosen_by_the_scene():
+    tm = _rectangle(2, 2, True)
+    sc = dc.Scene()
+    sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, 0.3), degree=1)
+    s = make_system(sc.model)
+    assert s.ksp.getType() == "cg" and s.ksp.getPC().getType() == "gamg"
+    s.destroy()
+    s = make_system(sc.model, solver="direct")
+    assert s.ksp.getPC().getFactorSolverType() == "mumps"
+    s.destroy()
+
+
+def test_self_weight_and_traction_reactions_small_strain():
+    """Geometrically linear check of the loads: the support reaction balances ρ g V plus a
+    traction on the top face times its length (per metre)."""
+    tm = _rectangle(4, 2, False)
+    sc = dc.Scene(large_rotations=False)
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, 0.2), degree=2)
+    sc.fix(b, "bottom")
+    sc.gravity(b, acceleration=(0.0, -9.81), density=2.0)
+    sc.load(b, "top", traction=(0.0, -3.0))
+    sc.monitor_reaction("base", b, "bottom")
+    res = dc.solve(sc, dc.LoadControl(steps=1))
+    expected = 2.0 * 9.81 * L * H + 3.0 * L
+    assert abs(res.history.column("base_Fy")[-1] - expected) < 1e-9 * expected
+    assert res.history.rows[-1]["iterations"] == 1
+    assert sc.effects()[1] == "dead loads"
+
+
+def test_bad_input_is_named():
+    tm = _rectangle(2, 2, True)
+    sc = dc.Scene()
+    with pytest.raises(ValueError, match="degree 3"):
+        sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, 0.3), degree=3)
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, 0.3))
+    with pytest.raises(ValueError, match="facets"):
+        sc.load(b, "block", traction=(1.0, 0.0))
+    with pytest.raises(ValueError, match="add_solid"):
+        dc.Scene().add_beam(tm, "block", section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(E))
+    with pytest.raises(NotImplementedError, match="one law per solid"):
+        sc.add_solid(tm, "block", material=dc.NeoHookean(E, 0.3))
+    with pytest.raises(dc.GroupNotFoundError):
+        sc.fix(b, "nowhere")

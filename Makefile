@@ -24,6 +24,8 @@ bench: setup
 	$(PY) benchmarks/beam2d.py
 	$(PY) benchmarks/pullout.py
 	$(PY) benchmarks/frame3d.py --sizes 7 15 32   # 10³, 10⁴, 10⁵ elements: about 20 minutes
+	$(PY) benchmarks/block3d.py                    # 116 k dofs SVK block: about 2 minutes
+	mpirun -n 2 $(PY) benchmarks/block3d.py
 
 # numba's on-disk cache does not see edits of inlined callees in other modules
 clean-cache:

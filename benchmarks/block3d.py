@@ -17,30 +17,12 @@ import time
 import numpy as np
 from mpi4py import MPI
 
-import dolfinx.mesh
-
 import dolfinx_corot as dc
 from dolfinx_corot.assembly import make_system
 from dolfinx_corot.io import output_dir
-from dolfinx_corot.io.mesh import TaggedMesh
+from dolfinx_corot.io.mesh import box
 
 comm = MPI.COMM_WORLD
-
-
-def block(nx, ny, nz, L=10.0):
-    mesh = dolfinx.mesh.create_box(comm, [np.zeros(3), np.array([L, 1.0, 1.0])], [nx, ny, nz],
-                                   dolfinx.mesh.CellType.hexahedron)
-    tdim = 3
-    cmap = mesh.topology.index_map(tdim)
-    cells = np.arange(cmap.size_local + cmap.num_ghosts, dtype=np.int32)
-    cell_tags = dolfinx.mesh.meshtags(mesh, tdim, cells, np.ones(len(cells), dtype=np.int32))
-    f0 = dolfinx.mesh.locate_entities_boundary(mesh, 2, lambda x: np.isclose(x[0], 0.0))
-    f1 = dolfinx.mesh.locate_entities_boundary(mesh, 2, lambda x: np.isclose(x[0], L))
-    facets = np.concatenate([f0, f1])
-    order = np.argsort(facets)
-    values = np.concatenate([np.full(len(f0), 2, dtype=np.int32), np.full(len(f1), 3, dtype=np.int32)])
-    facet_tags = dolfinx.mesh.meshtags(mesh, 2, facets[order], values[order])
-    return TaggedMesh(mesh, cell_tags, {"block": (3, 1), "clamp": (2, 2), "end": (2, 3)}, facet_tags=facet_tags)
 
 
 def main():
@@ -51,11 +33,11 @@ def main():
     ap.add_argument("--steps", type=int, default=5)
     args = ap.parse_args()
     t0 = time.perf_counter()
-    tm = block(*args.mesh)
+    tm = box((10.0, 1.0, 1.0), args.mesh)
     scene = dc.Scene(linear_solver=args.solver)
     b = scene.add_solid(tm, material=dc.SaintVenantKirchhoff(1e5, 0.3), degree=args.degree)
-    scene.fix(b, "clamp")
-    scene.load(b, "end", traction=(0.0, -75.0, 0.0))
+    scene.fix(b, "x0")
+    scene.load(b, "x1", traction=(0.0, -75.0, 0.0))
     system = make_system(scene.model, solver=args.solver)
     t_setup = time.perf_counter() - t0
     res = dc.solve(scene, dc.LoadControl(steps=args.steps), system=system)

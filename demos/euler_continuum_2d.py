@@ -54,6 +54,7 @@ import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
+from dolfinx_corot.closed_forms import cantilever_elastica_force_ratio
 from dolfinx_corot.io import output_dir, reference
 
 comm = MPI.COMM_WORLD
@@ -138,13 +139,7 @@ def run(nx: int, ny: int, degree: int):
     return scene, res, wall
 
 
-def elastica_ratio(w_over_L: float) -> float:
-    """F/F_cr of the inextensible cantilever elastica at lateral tip deflection w/L (< 0.806), on its first branch."""
-    from scipy.optimize import brentq
-    from scipy.special import ellipk
-
-    k = brentq(lambda k: 2.0 * k / ellipk(k * k) - w_over_L, 1e-12, 0.8375)  # 2k/K(k) is largest (0.806) there
-    return (2.0 * ellipk(k * k) / np.pi) ** 2
+elastica_ratio = cantilever_elastica_force_ratio
 
 
 # the closed form against the tabulated elastica of the reference

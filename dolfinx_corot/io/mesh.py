@@ -314,3 +314,28 @@ def from_arrays(points: np.ndarray, cells: np.ndarray, cell_name: str = "all",
         import uuid
         node_source = comm.bcast(f"arrays:{uuid.uuid4()}" if comm.rank == 0 else None, root=0)
     return TaggedMesh(msh, tags, groups, pts, ids, node_source=str(node_source))
+
+
+def box(lengths, n, cell: str = "hexahedron", comm: MPI.Comm = MPI.COMM_WORLD) -> TaggedMesh:
+    """A structured box [0, Lx] × [0, Ly] × [0, Lz] of ``n`` = (nx, ny, nz) hexahedra (or tetrahedra)
+    whose cells form the group "box" and whose faces are the facet groups "x0", "x1", "y0",
+    "y1", "z0", "z1"."""
+    lengths = np.asarray(lengths, dtype=float)
+    kind = {"hexahedron": dolfinx.mesh.CellType.hexahedron, "tetrahedron": dolfinx.mesh.CellType.tetrahedron}[cell]
+    mesh = dolfinx.mesh.create_box(comm, [np.zeros(3), lengths], list(n), kind)
+    cmap = mesh.topology.index_map(3)
+    cells = np.arange(cmap.size_local + cmap.num_ghosts, dtype=np.int32)
+    cell_tags = dolfinx.mesh.meshtags(mesh, 3, cells, np.ones(len(cells), dtype=np.int32))
+    groups = {"box": (3, 1)}
+    facets, values = [], []
+    for k, axis in enumerate("xyz"):
+        for side, value in (("0", 0.0), ("1", lengths[k])):
+            tag = 2 + 2 * k + (side == "1")
+            f = dolfinx.mesh.locate_entities_boundary(mesh, 2, lambda x, k=k, v=value: np.isclose(x[k], v))
+            facets.append(f)
+            values.append(np.full(len(f), tag, dtype=np.int32))
+            groups[f"{axis}{side}"] = (2, tag)
+    facets, values = np.concatenate(facets), np.concatenate(values)
+    order = np.argsort(facets)
+    facet_tags = dolfinx.mesh.meshtags(mesh, 2, facets[order], values[order])
+    return TaggedMesh(mesh, cell_tags, groups, facet_tags=facet_tags)

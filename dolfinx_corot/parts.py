@@ -45,7 +45,25 @@ class PartRef:
     kind: str
 
 
-class LineFrame:
+class PrescribedMotion:
+    """Prescribed displacements scaled by λ or amplitude(λ), shared by structures and solids:
+    ``_prescribed`` holds (where, comp, value, amplitude), ``_prescribed_values`` the BC
+    functions (g, dofs, value, amplitude) made by ``dirichlet_bcs``."""
+
+    _prescribed: list
+    _prescribed_values: list
+
+    @property
+    def has_prescribed_motion(self) -> bool:
+        return any(value != 0.0 for _, _, value, _ in self._prescribed)
+
+    def set_load_factor(self, load_factor: float) -> None:
+        """Set the prescribed displacements to λ (or amplitude(λ)) times their values."""
+        for g, dofs, value, amplitude in self._prescribed_values:
+            g.x.array[dofs] = (load_factor if amplitude is None else amplitude(load_factor)) * value
+
+
+class LineFrame(PrescribedMotion):
     """What 2D and 3D frames and shells share: cells, properties, supports, loads, forms, read-out."""
 
     tdim = 1
@@ -194,15 +212,6 @@ class LineFrame:
             self._prescribed_values.append((g, dofs[1], value, amplitude))
         self.lifting_bcs = bcs[len(bcs) - len(self._prescribed):]
         return bcs
-
-    @property
-    def has_prescribed_motion(self) -> bool:
-        return any(value != 0.0 for _, _, value, _ in self._prescribed)
-
-    def set_load_factor(self, load_factor: float) -> None:
-        """Set the prescribed displacements to λ (or amplitude(λ)) times their values."""
-        for g, dofs, value, amplitude in self._prescribed_values:
-            g.x.array[dofs] = (load_factor if amplitude is None else amplitude(load_factor)) * value
 
     def bending_blocks(self) -> np.ndarray:
         """Local blocks (owned and ghost) that a bending element on this rank touches."""
@@ -416,18 +425,16 @@ class Frame3D(LineFrame):
         return np.concatenate([s[:3], rotations.rotvec_from_quat(s[3:7].copy())])
 
 
-class Shell3D(LineFrame):
-    """Flat co-rotational shell triangles on a triangle mesh in space; dofs (ux, uy, uz, rx, ry, rz)
-    per node, rotations multiplicative as in :class:`Frame3D`."""
+class Surface3D(LineFrame):
+    """What shells and quadrilateral membranes share: 6 dofs per node with multiplicative
+    rotations as in :class:`Frame3D`, and per-cell constants (initial frame, local coordinates,
+    local stiffness) computed once by the kernels' ``element_data_all``."""
 
     tdim = 2
-    nodes_per_cell = 3
     gdim = 3
     dof_names = Frame3D.dof_names
     translations = 3
     state_size = kernels3d.NSTATE
-    nprops = shell_law.NPROPS
-    kernels = kernels_shell
     symmetric_tangent = False
     update = Frame3D.update
     extrapolate = Frame3D.extrapolate
@@ -435,14 +442,39 @@ class Shell3D(LineFrame):
     _dof_values = staticmethod(Frame3D._dof_values)
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
-        if tmesh.mesh.topology.cell_name() != "triangle":
-            raise NotImplementedError(f"shells are triangles; the mesh has {tmesh.mesh.topology.cell_name()} "
-                                      "cells (set Mesh.RecombineAll = 0 in gmsh)")
         super().__init__(tmesh, large_rotations)
         S = dolfinx.fem.VectorFunctionSpace(tmesh.mesh, ("Lagrange", 1), dim=kernels3d.NSTATE)
         self.state = dolfinx.fem.Function(S, name="state")
         self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, 3] = 1.0
         self._disp = dolfinx.fem.Function(self.V, name="displacement")
+
+    def _element_constants(self) -> list:
+        """The kernels' per-cell constants of every cell with elements (DG0, computed once)."""
+        mesh = self.tmesh.mesh
+        n = self.kernels.NEDATA
+        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=n)
+        edata = dolfinx.fem.Function(Q, name="element_constants")
+        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, self.nodes_per_cell)]
+        props = self.props.x.array.reshape(-1, self.nprops)[self._prop_blocks]
+        out = np.zeros((len(X), n))
+        self.kernels.element_data_all(X, props, self._owner_of_cell != "", out)
+        edata.x.array.reshape(-1, n)[Q.dofmap.list.array] = out
+        return [edata]
+
+
+class Shell3D(Surface3D):
+    """Flat co-rotational shell triangles on a triangle mesh in space; dofs (ux, uy, uz, rx, ry, rz)
+    per node, rotations multiplicative as in :class:`Frame3D`."""
+
+    nodes_per_cell = 3
+    nprops = shell_law.NPROPS
+    kernels = kernels_shell
+
+    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
+        if tmesh.mesh.topology.cell_name() != "triangle":
+            raise NotImplementedError(f"shells are triangles; the mesh has {tmesh.mesh.topology.cell_name()} "
+                                      "cells (set Mesh.RecombineAll = 0 in gmsh)")
+        super().__init__(tmesh, large_rotations)
 
     def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str = "opt"):
         label = f"shell '{where}'"
@@ -460,18 +492,6 @@ class Shell3D(LineFrame):
             raise ValueError(f"membrane '{where}': thickness = {thickness} must be positive")
         return self.add_elements(where, np.array([E, nu, thickness, 0.0, 0.0, 0.0]), False, "membrane")
 
-    def _element_constants(self) -> list:
-        """Initial frame, local coordinates and local stiffness of every cell (DG0, computed once)."""
-        mesh = self.tmesh.mesh
-        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=kernels_shell.NEDATA)
-        edata = dolfinx.fem.Function(Q, name="element_constants")
-        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 3)]
-        props = self.props.x.array.reshape(-1, self.nprops)[self._prop_blocks]
-        out = np.zeros((len(X), kernels_shell.NEDATA))
-        kernels_shell.element_data_all(X, props, self._owner_of_cell != "", out)
-        edata.x.array.reshape(-1, kernels_shell.NEDATA)[Q.dofmap.list.array] = out
-        return [edata]
-
     def _check_geometry(self, cells, label, props):
         x = self.tmesh.mesh.geometry.x
         g = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 3)[cells]
@@ -481,47 +501,18 @@ class Shell3D(LineFrame):
         self._refuse(cells, bad, x[g[:, 0]], f"{label}: {{n}} triangle(s) of zero area, the first at {{at}}")
 
 
-class MembraneQuad(LineFrame):
+class MembraneQuad(Surface3D):
     """Four-node co-rotational membranes on a quadrilateral mesh in space; dofs (ux, uy, uz, rx,
     ry, rz) per node like shells (so that they may share nodes with shells and beams), the
     rotations of nodes carried by membranes alone fixed."""
 
-    tdim = 2
     nodes_per_cell = 4
-    gdim = 3
-    dof_names = Frame3D.dof_names
-    translations = 3
-    state_size = kernels3d.NSTATE
     nprops = quad_law.NPROPS
     kernels = kernels_mq
-    symmetric_tangent = False
-    update = Frame3D.update
-    extrapolate = Frame3D.extrapolate
-    displacement_vector = Frame3D.displacement_vector
-    _dof_values = staticmethod(Frame3D._dof_values)
-
-    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
-        super().__init__(tmesh, large_rotations)
-        S = dolfinx.fem.VectorFunctionSpace(tmesh.mesh, ("Lagrange", 1), dim=kernels3d.NSTATE)
-        self.state = dolfinx.fem.Function(S, name="state")
-        self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, 3] = 1.0
-        self._disp = dolfinx.fem.Function(self.V, name="displacement")
 
     def add_membrane(self, where, E: float, nu: float, thickness: float):
         quad_law.check_props(E, nu, thickness, f"membrane '{where}'")
         return self.add_elements(where, np.array([E, nu, thickness]), False, "membrane")
-
-    def _element_constants(self) -> list:
-        """Initial frame, local coordinates and Q4 stiffness of every cell (DG0, computed once)."""
-        mesh = self.tmesh.mesh
-        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=kernels_mq.NEDATA)
-        edata = dolfinx.fem.Function(Q, name="element_constants")
-        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 4)]
-        props = self.props.x.array.reshape(-1, self.nprops)[self._prop_blocks]
-        out = np.zeros((len(X), kernels_mq.NEDATA))
-        kernels_mq.element_data_all(X, props, self._owner_of_cell != "", out)
-        edata.x.array.reshape(-1, kernels_mq.NEDATA)[Q.dofmap.list.array] = out
-        return [edata]
 
     def _check_geometry(self, cells, label, props):
         x = self.tmesh.mesh.geometry.x

@@ -27,6 +27,7 @@ import dolfinx.fem.petsc
 import dolfinx.la
 
 from ..io.mesh import TaggedMesh
+from ..parts import PartRef, PrescribedMotion
 from ..materials import Elastic
 from .kinematics import deformation_gradient
 from .laws import first_piola, lame
@@ -34,7 +35,7 @@ from .laws import first_piola, lame
 CELLS = ("triangle", "quadrilateral", "tetrahedron", "hexahedron")
 
 
-class Solid:
+class Solid(PrescribedMotion):
     """A large-deformation continuum on one mesh (see the module docstring)."""
 
     symmetric_tangent = True  # hyperelastic, dead loads
@@ -82,8 +83,6 @@ class Solid:
 
     # -- building -------------------------------------------------------------
     def add_region(self, where: str | None, material: Elastic):
-        from ..parts import PartRef
-
         label = f"solid '{where or 'all cells'}'"
         kind = type(material)
         if self.law is not None and kind is not self.law:
@@ -238,14 +237,6 @@ class Solid:
 
     def bending_blocks(self) -> np.ndarray:
         return np.zeros(self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts, dtype=bool)
-
-    @property
-    def has_prescribed_motion(self) -> bool:
-        return any(value != 0.0 for _, _, value, _ in self._prescribed)
-
-    def set_load_factor(self, load_factor: float) -> None:
-        for g, dofs, value, amplitude in self._prescribed_values:
-            g.x.array[dofs] = (load_factor if amplitude is None else amplitude(load_factor)) * value
 
     # -- linear solver -------------------------------------------------------------
     def near_nullspace(self) -> PETSc.NullSpace:

@@ -4,8 +4,16 @@ The user's model is a :class:`Scene`; a driver (:class:`LoadControl`)
 follows the load path; :func:`solve` returns a :class:`Result` with the
 per-step history.
 """
-from . import rotations
+import os as _os
+
+# one thread per MPI rank: a threaded BLAS/OpenMP runtime spins idle threads that take the
+# second core from the other rank (set before numpy loads BLAS; an explicit setting wins)
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+    _os.environ.setdefault(_var, "1")
+
+from . import rotations  # noqa: E402
 from .amplitudes import Amplitude
+from .contact.interface import AugmentedLagrangian, ContactError, Penalty
 from .io.mesh import GroupNotFoundError, TaggedMesh, from_gmsh
 from .materials import Elastic, NeoHookean, SaintVenantKirchhoff
 from .result import History, Result
@@ -15,6 +23,6 @@ from .solvers import ArcLength, ConvergenceError, LoadControl, NewtonOptions, so
 
 __version__ = "0.1.0"
 
-__all__ = ["Amplitude", "ArcLength", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
+__all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "ContactError", "Penalty", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
            "NeoHookean", "NewtonOptions", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
            "rotations", "solve"]

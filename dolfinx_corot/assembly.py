@@ -12,6 +12,7 @@ beams. Newton increments are homogeneous on supported dofs.
 """
 from __future__ import annotations
 
+import logging
 import time
 from dataclasses import dataclass
 from typing import Protocol, Sequence
@@ -25,6 +26,8 @@ import dolfinx.cpp
 import dolfinx.fem
 import dolfinx.fem.petsc
 import dolfinx.mesh
+
+logger = logging.getLogger(__name__)
 
 
 def kernel_form(V: dolfinx.fem.FunctionSpace, kernel_address: int, rank: int,
@@ -86,17 +89,25 @@ class Timings:
 class System:
     """Nonlinear system r(x, λ) = λ f_ext − f_int(x) = 0 of one model.
 
-    The linear solver is MUMPS: LDLᵀ (``symmetric=True``, the tangent of
+    The direct solver is MUMPS: LDLᵀ (``symmetric=True``, the tangent of
     conservative elastic structures) whose count of negative pivots is the
     number of negative eigenvalues of K (Sylvester's law; used to pass limit
-    points), or LU. PETSc options with the prefix ``dc_newton_`` override it
-    (e.g. ``-dc_newton_pc_type lu``).
+    points), or LU. The iterative solver (continua) is CG preconditioned by
+    smoothed-aggregation AMG with the rigid-body near-nullspace, on a
+    block (BAIJ) matrix; Newton chooses its tolerances (inexact Newton) and
+    when the AMG hierarchy is rebuilt (:class:`~dolfinx_corot.solvers.NewtonOptions`),
+    and a failed Krylov solve (indefinite tangent) is repeated with MUMPS LU.
+    PETSc options with the prefix ``dc_newton_`` override all of it
+    (e.g. ``-dc_newton_pc_type lu``, ``-dc_newton_pc_type gamg``).
     """
 
     def __init__(self, model: Model, options_prefix: str = "dc_newton_", symmetric: bool | None = None,
-                 solver: str = "direct"):
+                 solver: str = "direct", contacts: Sequence = ()):
         self.model = model
         self.comm = model.comm
+        # block-compressed rows for AMG on continua: nodal blocks are inserted and multiplied
+        # several times faster than in AIJ; MUMPS gets AIJ
+        self._mat_type = "baij" if solver == "iterative" else None
         self._build()
         self.fint = self.b.duplicate()
         self.dx = self.b.duplicate()
@@ -110,24 +121,53 @@ class System:
         self.amplitude_loads = [(amp, self._external_force(amp)) for amp in getattr(model, "amplitudes", [])]
         self.fext_total = self.b.duplicate()
         self.timings = Timings()
+        self.contact = None
+        if contacts:
+            if solver == "iterative":
+                raise NotImplementedError("contact needs the direct solver (linear_solver='direct' or 'auto')")
+            from .contact.interface import ContactSet
+
+            self.contact = ContactSet(contacts, self)
 
         if symmetric is None:
             symmetric = getattr(model, "symmetric_tangent", True)
         self.ksp = PETSc.KSP().create(self.comm)
         self.ksp.setOptionsPrefix(options_prefix)
         pc = self.ksp.getPC()
-        if solver == "iterative":
-            # CG + smoothed-aggregation AMG with the rigid-body near-nullspace (continua)
+        self.iterative = solver == "iterative"
+        self._fallback: PETSc.KSP | None = None
+        self.fallback_solves = 0
+        self.krylov_iterations = 0  # summed over iterative solves
+        if self.iterative:
+            # CG + smoothed-aggregation AMG with the rigid-body near-nullspace (continua): ML
+            # (Trilinos) with Chebyshev–Jacobi smoothing where PETSc has it, else PETSc's GAMG
             self.ksp.setType("cg" if symmetric else "gmres")
-            pc.setType("gamg")
-            self.ksp.setTolerances(rtol=1e-10, atol=1e-50, max_it=2000)
+            if PETSc.Sys.hasExternalPackage("ml"):
+                pc.setType("ml")
+                defaults = {"pc_ml_nullspace": "user", "mg_levels_ksp_type": "chebyshev",
+                            "mg_levels_pc_type": "jacobi"}
+                options = PETSc.Options()
+                for key, value in defaults.items():
+                    if not options.hasName(options_prefix + key):
+                        options[options_prefix + key] = value
+                # kept under our prefix: ML reads its level options at every set-up, not only now
+            else:
+                pc.setType("gamg")
+            self.ksp.setTolerances(rtol=1e-10, atol=1e-50, max_it=500)
             self._nullspace = model.near_nullspace()
             self.A.setNearNullSpace(self._nullspace)
+            # a tolerance given as a PETSc option is kept, and a linear problem is solved at
+            # once: no adaptive forcing then
+            self._fixed_rtol = PETSc.Options().hasName(options_prefix + "ksp_rtol") \
+                or not getattr(model, "large_rotations", True)
         else:
             self.ksp.setType("preonly")
             pc.setType("cholesky" if symmetric else "lu")
             pc.setFactorSolverType("mumps")
         self.ksp.setFromOptions()
+        # AMG needs AIJ: a converted copy of the block matrix builds the preconditioner
+        self.P: PETSc.Mat | None = None
+        self._reuse_pc = False
         self.ksp.setOperators(self.A)
         self._mumps = self.ksp.getType() == "preonly" and pc.getType() in ("lu", "cholesky") \
             and pc.getFactorSolverType() == "mumps"
@@ -141,7 +181,7 @@ class System:
     def _build(self) -> None:
         self.L, self.a = self.model.forms()
         self.bcs = self.model.dirichlet_bcs()
-        self.A = dolfinx.fem.petsc.create_matrix(self.a)
+        self.A = dolfinx.fem.petsc.create_matrix(self.a, self._mat_type)
         self.b = dolfinx.fem.petsc.create_vector(self.L)
 
     def _external_force(self, amplitude) -> PETSc.Vec:
@@ -158,6 +198,8 @@ class System:
             f.set(0.0)
         dolfinx.fem.petsc.assemble_vector(self.fint, self.L)
         self.fint.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        if self.contact is not None:
+            self.contact.add_force(self.fint)
 
     def _constrain_residual(self, load_factor: float) -> None:
         x = self.model.displacement_vector()
@@ -227,6 +269,16 @@ class System:
         self.A.zeroEntries()
         dolfinx.fem.petsc.assemble_matrix(self.A, self.a, bcs=self.bcs)
         self.A.assemble()
+        if self.contact is not None:
+            self.contact.add_tangent(self.A)
+        if self._mat_type == "baij":
+            # the AMG's finest level smooths with P: P follows A even when the hierarchy is kept
+            if self.P is None:
+                self.P = self.A.convert("aij", PETSc.Mat())  # a new matrix (out=None converts in place)
+                self.P.setNearNullSpace(self._nullspace)
+                self.ksp.setOperators(self.A, self.P)
+            else:
+                self.A.convert("aij", self.P)
         self.timings.assembly += time.perf_counter() - t
 
     def solve(self, rhs: PETSc.Vec | None = None, out: PETSc.Vec | None = None) -> float:
@@ -236,6 +288,14 @@ class System:
         t = time.perf_counter()
         self.ksp.solve(rhs, out)
         reason = self.ksp.getConvergedReason()
+        if self.iterative:
+            self.krylov_iterations += self.ksp.getIterationNumber()
+        if reason < 0 and self.iterative:
+            # CG + GAMG fails on an indefinite tangent (past a bifurcation or a limit point):
+            # this solve is repeated with a sparse LU (MUMPS); the next ones try CG again
+            logger.warning("CG + GAMG failed (PETSc reason %d after %d iterations): solving with MUMPS LU",
+                           reason, self.ksp.getIterationNumber())
+            reason = self._direct_solve(rhs, out)
         self.timings.solve += time.perf_counter() - t
         if reason < 0:
             raise np.linalg.LinAlgError(f"linear solve failed (PETSc reason {reason}); "
@@ -247,6 +307,31 @@ class System:
                     f"the tangent stiffness is singular ({null_pivots} zero pivot(s)): a missing support "
                     "(rigid-body motion), a mechanism, or a limit point under load control")
         return out.norm()
+
+    def _direct_solve(self, rhs: PETSc.Vec, out: PETSc.Vec) -> int:
+        if self._fallback is None:
+            self._fallback = PETSc.KSP().create(self.comm)
+            self._fallback.setType("preonly")
+            pc = self._fallback.getPC()
+            pc.setType("lu")
+            pc.setFactorSolverType("mumps")
+        self._fallback.setOperators(self.A)
+        self._fallback.solve(rhs, out)
+        self.fallback_solves += 1
+        return self._fallback.getConvergedReason()
+
+    def set_forcing(self, eta: float | None) -> None:
+        """Relative tolerance of the next iterative solves (inexact Newton; None: back to 1e-10);
+        ignored by direct solvers and when ``-<prefix>ksp_rtol`` was given."""
+        if self.iterative and not self._fixed_rtol:
+            self.ksp.setTolerances(rtol=1e-10 if eta is None else eta)
+
+    def reuse_preconditioner(self, reuse: bool) -> None:
+        """Keep the preconditioner of an earlier tangent for the next iterative solves (the matrix
+        is still the current tangent: only the convergence rate of the Krylov solver changes)."""
+        if self.iterative:
+            self._reuse_pc = bool(reuse)
+            self.ksp.getPC().setReusePreconditioner(self._reuse_pc)
 
     def negative_eigenvalues(self) -> int | None:
         """Number of negative eigenvalues of the last factorized tangent (LDLᵀ only; else None)."""
@@ -289,19 +374,48 @@ class System:
 
     def extrapolate(self, older, newer, factor: float) -> None:
         """Set x to newer ⊕ factor·(newer ⊖ older) (a secant predictor)."""
+        if self.contact is not None:
+            older, newer = older[0], newer[0]
         self.model.extrapolate(older, newer, factor)
 
     def checkpoint(self):
+        """The model's state (and the contact multipliers, if any)."""
+        if self.contact is not None:
+            return (self.model.checkpoint(), self.contact.checkpoint())
         return self.model.checkpoint()
 
     def restore(self, cp) -> None:
+        if self.contact is not None:
+            self.model.restore(cp[0])
+            self.contact.restore(cp[1])
+            return
         self.model.restore(cp)
+
+    # -- numbering (contact) -------------------------------------------------------
+    def global_dofs(self, model, local_dofs: np.ndarray) -> np.ndarray:
+        """Global system dofs of ``model``'s local unrolled dofs."""
+        return self.A.getLGMap()[0].apply(np.asarray(local_dofs, dtype=PETSc.IntType)).astype(np.int64)
+
+    def constrained_global_dofs(self) -> np.ndarray:
+        """All constrained dofs (supports and prescribed motion), global numbering, on every rank."""
+        own = [self.global_dofs(self.model, bc.dof_indices()[0][: bc.dof_indices()[1]]) for bc in self.bcs]
+        own = np.concatenate(own) if own else np.zeros(0, dtype=np.int64)
+        return np.unique(np.concatenate(self.comm.allgather(own)))
+
+    def ownership_range(self) -> tuple[int, int]:
+        return self.A.getOwnershipRange()
 
     def internal_force(self) -> PETSc.Vec:
         """f_int at the last residual, all dofs: on supported dofs it is the reaction."""
         return self.fint
 
     def destroy(self) -> None:
+        if self._fallback is not None:
+            self._fallback.destroy()
+        if self.contact is not None:
+            self.contact.destroy()
+        if self.P is not None:
+            self.P.destroy()
         for obj in (self.ksp, self.A, self.b, self.fint, self.dx, self.step_dx, self.lift, self.fext,
                     self.fext_total, *(v for _, v in self.amplitude_loads)):
             obj.destroy()
@@ -491,6 +605,8 @@ class CoupledSystem(System):
             with v.localForm() as f:
                 arrays.append(f.array.copy())
         self._add_from_models(self.fint, arrays)
+        if self.contact is not None:
+            self.contact.add_force(self.fint)
 
     def _displacements(self) -> np.ndarray:
         """Owned entries of the displacement vector (rotational entries 0)."""
@@ -522,6 +638,8 @@ class CoupledSystem(System):
                                                   dolfinx.fem.petsc._pack_coefficients(a), [], True)
         A.setLGMap(*lg0)
         A.assemble()
+        if self.contact is not None:
+            self.contact.add_tangent(A)
         rows = (self._fixed + self.layout.start).astype(PETSc.IntType)
         if self._lift_pending and self._prescribed:
             A.zeroRowsColumns(rows, 1.0, self.lift, self.b)
@@ -545,6 +663,16 @@ class CoupledSystem(System):
                 m.update(v)
         self.step_dx.axpy(scale, self.dx)
         self.timings.update += time.perf_counter() - t
+
+    def global_dofs(self, model, local_dofs: np.ndarray) -> np.ndarray:
+        return self.layout.gdofs[self.model.models.index(model)][np.asarray(local_dofs)].astype(np.int64)
+
+    def constrained_global_dofs(self) -> np.ndarray:
+        own = (self._fixed + self.layout.start).astype(np.int64)
+        return np.unique(np.concatenate(self.comm.allgather(own)))
+
+    def ownership_range(self) -> tuple[int, int]:
+        return self.layout.start, self.layout.start + self.layout.n_owned
 
     # -- checkpoint files ------------------------------------------------------------
     def global_arrays(self, vectors: dict) -> dict:
@@ -577,7 +705,7 @@ def make_system(model, solver: str = "auto", **kwargs) -> System:
     'auto': iterative for a continuum alone, direct for structures and coupled parts.
     """
     if solver == "auto":
-        solver = "iterative" if hasattr(model, "near_nullspace") else "direct"
+        solver = "iterative" if hasattr(model, "near_nullspace") and not kwargs.get("contacts") else "direct"
     if solver == "iterative" and not hasattr(model, "near_nullspace"):
         raise NotImplementedError("the iterative solver (CG + GAMG) is for continua alone; structures and coupled "
                                   "parts use the direct solver")

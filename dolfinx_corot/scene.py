@@ -60,6 +60,7 @@ class Scene:
         self.monitors: list[Monitor] = []
         self._loads = 0
         self._prescribed = 0
+        self.interfaces: list = []
 
     # -- parts -----------------------------------------------------------------
     def _model(self, tmesh: TaggedMesh, solid_degree: int | None = None) -> LineFrame:
@@ -265,6 +266,23 @@ class Scene:
         part.model.add_body_force(where, density * acc, amplitude)
         self._loads += 1
 
+    def contact(self, slaves: tuple[PartRef, str], masters: tuple[PartRef, str], law=None,
+                symmetric: bool = False) -> list:
+        """Node-to-segment contact (2D, frictionless) of the nodes of boundary group ``slaves[1]``
+        of part ``slaves[0]`` against the boundary segments of ``masters``; ``symmetric`` adds
+        the other direction (two-pass contact, for two deformable bodies).
+
+        law: dc.Penalty() (default) or dc.AugmentedLagrangian(); the default penalty scales with
+        the bodies' stiffness and the master segments' length. Returns the interfaces made."""
+        from .contact.interface import Interface, Penalty
+
+        law = Penalty() if law is None else law
+        made = [Interface(slaves, masters, law)]
+        if symmetric:
+            made.append(Interface(masters, slaves, law))
+        self.interfaces += made
+        return made
+
     def monitor(self, name: str, part: PartRef, where: str) -> None:
         """Record the dofs of the (first) node of group ``where`` after every step, as
         ``name_ux``, ``name_uy``, … In 2D ``name_rz`` is the total angle (it may exceed 2π);
@@ -307,6 +325,10 @@ class Scene:
             out.append("dead loads")
         if self._prescribed:
             out.append("prescribed displacements")
+        for itf in self.interfaces:
+            kind = "augmented Lagrangian" if itf.law.augmented else "penalty"
+            out.append(f"contact {itf.name}: {len(itf.area)} slave nodes on {len(itf.master['segments'])} "
+                       f"segments ({kind}, penalty {itf.penalty:.3g})")
         return out
 
     def monitor_values(self, system) -> dict[str, float]:

@@ -30,6 +30,26 @@ from .newton import ConvergenceError, NewtonOptions, NewtonReport, converged, ne
 logger = logging.getLogger(__name__)
 
 
+def newton_with_contact(system, load_factor: float, options: NewtonOptions) -> NewtonReport:
+    """Newton at ``load_factor``, then, for augmented-Lagrangian contact, Uzawa updates of the
+    contact pressures each followed by a new Newton solve until the penetrations are below
+    tolerance. The report sums the iterations; ``uzawa`` counts the updates."""
+    contact = getattr(system, "contact", None)
+    if contact is not None:
+        contact.begin_step()
+    report = newton(system, load_factor, options)
+    report.uzawa = 0
+    if contact is None:
+        return report
+    while report.converged and contact.augment():
+        again = newton(system, load_factor, options)
+        again.uzawa = report.uzawa + 1
+        again.iterations += report.iterations
+        again.residuals = report.residuals + again.residuals
+        report = again
+    return report
+
+
 class _Run:
     """Bookkeeping shared by the drivers: history rows, totals, failure, checkpoints."""
 
@@ -59,6 +79,8 @@ class _Run:
                "time_assembly": tm.assembly - tm0.assembly, "time_solve": tm.solve - tm0.solve,
                "time_update": tm.update - tm0.update,
                "residuals": " ".join(f"{r:.2e}" for r in report.residuals)}
+        if getattr(self.system, "contact", None) is not None:
+            row["uzawa_updates"] = getattr(report, "uzawa", 0)
         row.update(extra or {})
         row.update(self.scene.monitor_values(self.system))
         self.history.append(row)
@@ -165,7 +187,7 @@ class LoadControl:
                 if self.extrapolate and previous is not None and lam != previous[0]:
                     # secant predictor along the last converged increment
                     system.extrapolate(previous[1], cp, (trial - lam) / (lam - previous[0]))
-                report = newton(system, trial, self.newton)
+                report = newton_with_contact(system, trial, self.newton)
                 if not report.converged:
                     system.restore(cp)
                     cuts += 1
@@ -363,7 +385,8 @@ def solve(scene, driver, system: System | None = None, on_step=None, checkpoint:
     """
     own_system = system is None
     if own_system:
-        system = make_system(scene.model, solver=getattr(scene, "linear_solver", "auto"))
+        system = make_system(scene.model, solver=getattr(scene, "linear_solver", "auto"),
+                             contacts=getattr(scene, "interfaces", ()))
     try:
         return driver.run(_Run(scene, system, on_step, checkpoint), restart)
     finally:

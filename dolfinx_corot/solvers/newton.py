@@ -40,7 +40,14 @@ class NewtonOptions:
     the step's increment; max_iterations per attempt;
     divergence_factor: ‖r‖ above this multiple of max(initial ‖r‖, reference force) is divergence;
     line_search: scale the correction so that the energy is nearly stationary along it
-    (at most ``line_search_trials`` extra residual evaluations per iteration)."""
+    (at most ``line_search_trials`` extra residual evaluations per iteration);
+    forcing: inexact Newton for iterative linear solvers (Eisenstat & Walker 1996, choice 2):
+    the first solve of a step to ``forcing_initial``, then to
+    η_k = γ (‖r_k‖/‖r_{k−1}‖)², kept below ``forcing_max`` and not below what the
+    final tolerance needs; direct solvers ignore it;
+    preconditioner: 'step' builds the iterative solver's preconditioner (AMG) from the first
+    tangent of each step and keeps it for the step's later iterations, 'iteration' rebuilds it
+    every iteration."""
 
     rtol: float = 1e-9
     atol: float = 0.0
@@ -51,6 +58,11 @@ class NewtonOptions:
     line_search_trials: int = 4
     line_search_tolerance: float = 0.5
     max_growth: int = 3
+    forcing: bool = True
+    forcing_initial: float = 1e-3
+    forcing_max: float = 1e-2
+    forcing_gamma: float = 0.9
+    preconditioner: str = "step"
 
 
 @dataclass
@@ -60,6 +72,7 @@ class NewtonReport:
     residuals: list[float] = field(default_factory=list)
     increments: list[float] = field(default_factory=list)
     reason: str = ""
+    uzawa: int = 0  # augmented-Lagrangian updates (contact)
 
     def rate(self) -> float:
         """Estimated order of convergence from the last three residuals (nan if too few)."""
@@ -93,6 +106,12 @@ def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions())
         if norm <= tol or small_correction:
             report.converged = True
             break
+        if getattr(system, "iterative", False):
+            system.reuse_preconditioner(options.preconditioner == "step" and it > 1)
+            if options.forcing:
+                eta = forcing_term(options, norm, report.residuals[-2] if it > 1 else None,
+                                   eta if it > 1 else None, tol)
+                system.set_forcing(eta)
         system.jacobian()
         try:
             report.increments.append(system.solve())
@@ -122,7 +141,27 @@ def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions())
         if not report.converged:
             report.reason = (f"no convergence in {options.max_iterations} iterations: |r| = {norm:.3e} "
                              f"> tolerance {tol:.3e}")
+    if getattr(system, "iterative", False):
+        system.set_forcing(None)
+        system.reuse_preconditioner(False)
     return report
+
+
+def forcing_term(options: NewtonOptions, norm: float, previous: float | None, eta_previous: float | None,
+                 tol: float) -> float:
+    """Relative tolerance of the linear solve at residual ``norm`` (Eisenstat–Walker, choice 2,
+    with their safeguard against a sudden decrease of η); floored at half the remaining way
+    to the Newton tolerance, so that the last solve does not over-solve."""
+    if previous is None or not previous > 0.0:
+        eta = options.forcing_initial
+    else:
+        eta = options.forcing_gamma * (norm / previous) ** 2
+        if eta_previous is not None and options.forcing_gamma * eta_previous ** 2 > 0.1:
+            eta = max(eta, options.forcing_gamma * eta_previous ** 2)
+    eta = min(eta, options.forcing_max)
+    if norm > 0.0:
+        eta = max(eta, 0.5 * tol / norm)
+    return float(min(max(eta, 1e-12), options.forcing_max))
 
 
 def _line_search(system, load_factor: float, trials: int, tolerance: float) -> tuple[float, float]:

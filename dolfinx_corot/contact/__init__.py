@@ -1,0 +1,1 @@
+"""Node-to-segment contact: search, kernels, interfaces."""

@@ -1,0 +1,399 @@
+r"""Contact interfaces in 2D: slave nodes of one body against master segments of another.
+
+An :class:`Interface` pairs the nodes of a boundary group of one part (the
+slaves, or contactors) with the boundary segments of a group of another
+part (the masters). Every rank holds both surfaces whole (contact
+surfaces are small next to the bodies): reference coordinates, the global
+dofs of their nodes and the orientation of the master segments, whose
+body lies on the left of each segment. At each residual evaluation the
+current positions are gathered, the broad phase (bounding boxes inflated
+by a margin) gives the candidate pairs, the narrow phase picks for each
+slave the segment of its closest point, and the kernel
+(:mod:`.kernels2d`) gives forces and the consistent tangent.
+
+Each rank evaluates the slaves whose dofs it owns. Forces go into the
+internal-force vector, the tangent into a matrix C with a COO pattern over
+all candidate pairs (entries on constrained dofs are left out), added to
+the system matrix. The pattern is rebuilt only when the candidate set
+grows (a slave moves more than half the margin since the last search).
+
+Laws (Wriggers 2006, §6.2 and §10.3; Simo & Laursen 1992):
+
+* :class:`Penalty` — pressure p = ε⟨−g⟩ with ε in pressure per unit
+  penetration; by default ε = ``factor`` · E*/h with E* the smallest
+  plane-strain modulus E/(1−ν²) of the two bodies and h the mean master
+  segment length.
+* :class:`AugmentedLagrangian` — p = ⟨λ − ε g⟩; after each converged
+  Newton solve λ ← ⟨λ − ε g⟩ (Uzawa) until the largest penetration is below
+  ``gap_tolerance`` · h; multipliers are carried over to the next step.
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from .kernels2d import node_to_segment
+from .search import broad_phase, narrow_phase
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Penalty:
+    """Penalty contact. penalty: ε in pressure per unit penetration (None: ``factor`` · E*/h)."""
+
+    penalty: float | None = None
+    factor: float = 10.0
+
+    augmented = False
+
+
+@dataclass(frozen=True)
+class AugmentedLagrangian(Penalty):
+    """Penalty plus Uzawa updates of the contact pressure until the largest penetration is below
+    ``gap_tolerance`` times the mean master segment length (at most ``max_updates`` per step)."""
+
+    gap_tolerance: float = 1e-4
+    max_updates: int = 10
+
+    augmented = True
+
+
+class ContactError(ValueError):
+    """A contact surface that cannot be built (missing group, unsupported part)."""
+
+
+def boundary_surface(part, where: str) -> dict:
+    """Nodes and oriented segments of the facet group ``where`` of a 2D solid part, on every rank.
+
+    Returns {"key": (n,) global node keys, "X": (n, 2) reference coordinates, "local": (n_own,)
+    positions of this rank's owned nodes in the arrays, "ldofs": (n_own, 2) their local unrolled dofs
+    in the model, "segments": (m, 2) node indices with the body on the left}."""
+    model = part.model
+    from ..continuum.solid import Solid
+
+    if not isinstance(model, Solid) or model.gdim != 2:
+        raise ContactError(f"contact surface '{where}': only boundaries of 2D solids are supported so far "
+                           f"(got a {type(model).__name__} in {model.gdim}D)")
+    if model.degree != 1:
+        raise ContactError(f"contact surface '{where}': node-to-segment contact needs linear solids "
+                           f"(degree 1); this solid has degree {model.degree}")
+    tm = model.tmesh
+    facets = tm.facets(where)
+    if facets is None:
+        raise ContactError(f"contact surface '{where}' is not a group of boundary lines of the solid mesh "
+                           f"(groups: {sorted(tm.groups)})")
+    mesh = tm.mesh
+    tdim = 2
+    mesh.topology.create_connectivity(1, tdim)
+    mesh.topology.create_connectivity(1, 0)
+    f2c = mesh.topology.connectivity(1, tdim)
+    f2v = mesh.topology.connectivity(1, 0)
+    c2v = mesh.topology.connectivity(tdim, 0)
+    n_owned_cells = mesh.topology.index_map(tdim).size_local
+    V = model.V
+    bs = V.dofmap.index_map_bs
+    imap = V.dofmap.index_map
+    n_owned_blocks = imap.size_local
+    Xdof = V.tabulate_dof_coordinates()[:, :2]
+    seg_blocks, seg_owned = [], []
+    for f in facets:
+        cells = f2c.links(f)
+        if len(cells) != 1:
+            raise ContactError(f"contact surface '{where}': facet {f} is not on the boundary of the solid")
+        c = cells[0]
+        if c >= n_owned_cells:
+            continue  # the owner of the cell adds this facet
+        cv = list(c2v.links(c))
+        cd = V.dofmap.cell_dofs(c)
+        a, b = (cd[cv.index(v)] for v in f2v.links(f))
+        centroid = Xdof[cd].mean(axis=0)
+        t = Xdof[b] - Xdof[a]
+        n = np.array([t[1], -t[0]])
+        if np.dot(0.5 * (Xdof[a] + Xdof[b]) - centroid, n) < 0.0:
+            a, b = b, a
+        seg_blocks.append((a, b))
+    seg_blocks = np.array(seg_blocks, dtype=np.int64).reshape(-1, 2)
+    # node keys: global block numbers of the model's function space
+    gblocks = imap.local_to_global(np.arange(imap.size_local + imap.num_ghosts, dtype=np.int32))
+    comm = model.comm
+    seg_keys = np.concatenate(comm.allgather(gblocks[seg_blocks].reshape(-1, 2))) if True else None
+    if len(seg_keys) == 0:
+        raise ContactError(f"contact surface '{where}' has no facets")
+    keys, segments = np.unique(seg_keys, return_inverse=True)
+    segments = segments.reshape(-1, 2)
+    X = np.zeros((len(keys), 2))
+    mine = np.isin(gblocks[:n_owned_blocks], keys)
+    own_blocks = np.flatnonzero(mine)
+    own_pos = np.searchsorted(keys, gblocks[own_blocks])
+    for pos, x in zip(comm.allgather(own_pos), comm.allgather(Xdof[own_blocks])):
+        X[pos] = x
+    ldofs = (own_blocks[:, None] * bs + np.arange(2)[None, :]).astype(np.int32)
+    return {"keys": keys, "X": X, "local": own_pos, "ldofs": ldofs, "segments": segments, "model": model}
+
+
+def _tributary_lengths(X: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """Half the summed lengths of the segments at each node (the node's share of the boundary)."""
+    length = np.linalg.norm(X[segments[:, 1]] - X[segments[:, 0]], axis=1)
+    out = np.zeros(len(X))
+    np.add.at(out, segments[:, 0], 0.5 * length)
+    np.add.at(out, segments[:, 1], 0.5 * length)
+    return out
+
+
+class Interface:
+    """One direction of contact: the nodes of ``slaves`` against the segments of ``masters``
+    (each a (part, boundary group name) pair). The symmetric (two-pass) contact of two
+    deformable bodies is two interfaces, one each way."""
+
+    def __init__(self, slaves, masters, law: Penalty):
+        if not isinstance(law, Penalty):
+            raise TypeError(f"contact law must be dc.Penalty or dc.AugmentedLagrangian, got {type(law).__name__}")
+        self.slave_spec, self.master_spec, self.law = slaves, masters, law
+        self.slave = boundary_surface(*slaves)
+        self.master = boundary_surface(*masters)
+        self.name = f"{slaves[1]} -> {masters[1]}"
+        # slaves: all nodes of the slave group; their tributary lengths on the slave boundary
+        self.area = _tributary_lengths(self.slave["X"], self.slave["segments"])
+        Xm, sm = self.master["X"], self.master["segments"]
+        self.h = float(np.mean(np.linalg.norm(Xm[sm[:, 1]] - Xm[sm[:, 0]], axis=1)))
+        if law.penalty is not None:
+            if not law.penalty > 0.0:
+                raise ValueError(f"contact '{self.name}': the penalty must be positive, got {law.penalty}")
+            self.penalty = float(law.penalty)
+        else:
+            moduli = []
+            for surf in (self.slave, self.master):
+                m = surf["model"]
+                E, nu = m.E.x.array, m.nu.x.array
+                moduli.append(m.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN))
+            self.penalty = law.factor * min(moduli) / self.h
+        self.multiplier = np.zeros(len(self.area))
+        self.margin = 0.5 * self.h
+        self.touch = 1e-12 * self.h  # a gap below this is closed (round-off of touching bodies)
+        self.uzawa_updates = 0
+
+    # -- binding to a system ---------------------------------------------------------
+    def bind(self, system) -> None:
+        """Global dofs of both surfaces in ``system``'s numbering; the dofs it constrains."""
+        for surf in (self.slave, self.master):
+            comm = surf["model"].comm
+            g = system.global_dofs(surf["model"], surf["ldofs"].ravel()).reshape(-1, 2)
+            gd = np.zeros((len(surf["keys"]), 2), dtype=np.int64)
+            for pos, vals in zip(comm.allgather(surf["local"]), comm.allgather(g)):
+                gd[pos] = vals
+            surf["gdofs"] = gd
+        self.comm = self.slave["model"].comm
+        self.constrained = system.constrained_global_dofs()
+        n = len(self.area)
+        # each rank evaluates the slaves whose x dof it owns
+        start, stop = system.ownership_range()
+        self.mine = np.flatnonzero((self.slave["gdofs"][:, 0] >= start) & (self.slave["gdofs"][:, 0] < stop))
+        self.candidates = np.zeros((0, 2), dtype=np.int64)
+        self.anchor = None  # slave and master positions at the last search
+        self.pairs_changed = True
+        self.K = None
+        self.active = np.full(n, -1)
+
+    def _positions(self, surf) -> np.ndarray:
+        u = surf["model"].state.x.array[surf["ldofs"]]
+        x = surf["X"].copy()
+        for pos, vals in zip(self.comm.allgather(surf["local"]), self.comm.allgather(u)):
+            x[pos] += vals
+        return x
+
+    def _search(self, xs, xm) -> None:
+        moved = np.inf if self.anchor is None else max(
+            np.abs(xs - self.anchor[0]).max(initial=0.0), np.abs(xm - self.anchor[1]).max(initial=0.0))
+        if moved <= 0.5 * self.margin:
+            return
+        seg = self.master["segments"]
+        pairs = broad_phase(xs[self.mine], xm[seg[:, 0]], xm[seg[:, 1]], self.margin)
+        pairs[:, 0] = self.mine[pairs[:, 0]]
+        union = np.unique(np.vstack([self.candidates, pairs]), axis=0)
+        grown = self.comm.allreduce(int(len(union) > len(self.candidates)), op=MPI.MAX)
+        if grown:
+            self.candidates = union
+            self.pairs_changed = True
+        self.anchor = (xs.copy(), xm.copy())
+
+    def evaluate(self):
+        """Forces and tangents of this rank's slaves at the current configuration.
+
+        Returns (dofs (k, 6) global, f (k, 6), K (k, 6, 6), (slave, segment) (k,)) over the
+        pairs in contact (p > 0)."""
+        xs, xm = self._positions(self.slave), self._positions(self.master)
+        self._search(xs, xm)
+        seg = self.master["segments"]
+        mine_pairs = self.candidates
+        self.active[:] = -1
+        if len(mine_pairs) == 0:
+            self._last = (np.zeros(0, dtype=np.int64), np.zeros(0))
+            self._forces = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 6)))
+            return (np.zeros((0, 6), dtype=np.int64), np.zeros((0, 6)), np.zeros((0, 6, 6)),
+                    (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)))
+        # narrow phase over this rank's candidates: closest segment per slave
+        segment, xi = narrow_phase(xs, xm[seg[:, 0]], xm[seg[:, 1]], mine_pairs)
+        s = self.mine[segment[self.mine] >= 0]
+        m = segment[s]
+        self.active[s] = m
+        g, xi, p, f, K, _ = node_to_segment(xs[s], xm[seg[m, 0]], xm[seg[m, 1]], self.multiplier[s],
+                                           np.full(len(s), self.penalty), self.area[s], True, self.touch)
+        keep = (self.multiplier[s] - self.penalty * g) >= -self.penalty * self.touch  # closed or touching
+        dofs = np.hstack([self.slave["gdofs"][s], self.master["gdofs"][seg[m, 0]],
+                          self.master["gdofs"][seg[m, 1]]])
+        self._last = (s, g)
+        self._forces = (s[keep], m[keep], f[keep])
+        return dofs[keep], f[keep], K[keep], (s[keep], m[keep])
+
+    def gaps(self) -> tuple[np.ndarray, np.ndarray]:
+        """(slave indices, gaps) of this rank's slaves that have a master segment now."""
+        return self._last
+
+    def augment(self) -> bool:
+        """Uzawa update λ ← ⟨λ − ε g⟩ if the largest |g| of the pairs in contact exceeds the
+        tolerance (all ranks agree); returns whether the multipliers changed."""
+        if not self.law.augmented:
+            return False
+        s, g = self._last
+        # in contact (p > 0) the gap should vanish: penetration, or an opening the pressure holds
+        closed = self.multiplier[s] - self.penalty * g > 0.0
+        error = self.comm.allreduce(float(np.max(np.abs(g[closed]), initial=0.0)), op=MPI.MAX)
+        if error <= self.law.gap_tolerance * self.h or self.uzawa_updates >= self.law.max_updates:
+            return False
+        new = np.zeros_like(self.multiplier)
+        new[s] = np.maximum(0.0, self.multiplier[s] - self.penalty * g)
+        lam = np.zeros_like(new)
+        self.comm.Allreduce(new, lam, op=MPI.SUM)
+        self.multiplier[:] = lam
+        self.uzawa_updates += 1
+        return True
+
+    def pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Coordinates (n, 2) and contact pressure (n,) of all slave nodes, on every rank, at the
+        last evaluation: the nominal pressure ⟨λ − ε g⟩ per reference length with the reference
+        coordinates, or (``current``) the true pressure, the nodal force per current tributary
+        length, with the current coordinates."""
+        s, g = self._last
+        p = np.zeros(len(self.area))
+        p[s] = np.maximum(0.0, self.multiplier[s] - self.penalty * g)
+        out = np.zeros_like(p)
+        self.comm.Allreduce(p, out, op=MPI.SUM)
+        if not current:
+            return self.slave["X"], out
+        x = self._positions(self.slave)
+        return x, out * self.area / _tributary_lengths(x, self.slave["segments"])
+
+    def master_pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Contact pressure on the master side: the contact forces on each master node over its
+        tributary length (n_master,), with the nodes' coordinates (n_master, 2), on every rank."""
+        s, m, f = self._forces
+        seg = self.master["segments"]
+        force = np.zeros((len(self.master["X"]), 2))
+        np.add.at(force, seg[m, 0], f[:, 2:4])
+        np.add.at(force, seg[m, 1], f[:, 4:6])
+        total = np.zeros_like(force)
+        self.comm.Allreduce(force, total, op=MPI.SUM)
+        length = _tributary_lengths(self.master["X"], seg)
+        x = self._positions(self.master) if current else self.master["X"]
+        return x, np.linalg.norm(total, axis=1) / length
+
+
+class ContactSet:
+    """The interfaces of a scene bound to one system: adds their forces to f_int and their
+    tangent to the system matrix through a COO matrix over the candidate pairs."""
+
+    def __init__(self, interfaces, system):
+        self.interfaces = list(interfaces)
+        for itf in self.interfaces:
+            itf.bind(system)
+        self.comm = system.comm
+        self.C: PETSc.Mat | None = None
+        self._merged = False
+        self._blocks = []
+        self.pattern_builds = 0
+
+    def add_force(self, fint: PETSc.Vec) -> None:
+        """Evaluate every interface at the current configuration; fint += contact forces."""
+        self._blocks = []
+        for itf in self.interfaces:
+            dofs, f, K, pairs = itf.evaluate()
+            self._blocks.append((dofs, K, pairs))
+            fint.setValues(dofs.ravel().astype(PETSc.IntType), f.ravel(), addv=PETSc.InsertMode.ADD_VALUES)
+        fint.assemblyBegin()
+        fint.assemblyEnd()
+
+    def _pair_dofs(self, itf, slaves, segments) -> np.ndarray:
+        """Global dofs (k, 6) of slave–segment pairs, −1 on constrained dofs (PETSc skips them)."""
+        seg = itf.master["segments"]
+        dofs = np.hstack([itf.slave["gdofs"][slaves], itf.master["gdofs"][seg[segments, 0]],
+                          itf.master["gdofs"][seg[segments, 1]]])
+        dofs[np.isin(dofs, itf.constrained)] = -1
+        return dofs
+
+    def _build_pattern(self, A: PETSc.Mat) -> None:
+        """C's pattern: the 6 × 6 blocks of every candidate pair of every rank, row by row."""
+        rows, cols = [], []
+        for itf in self.interfaces:
+            c = itf.candidates
+            dofs = self._pair_dofs(itf, c[:, 0], c[:, 1])
+            rows.append(np.repeat(dofs, 6, axis=1).ravel())
+            cols.append(np.tile(dofs, (1, 6)).ravel())
+        r, q = np.concatenate(rows), np.concatenate(cols)
+        keep = (r >= 0) & (q >= 0)
+        entries = np.unique(np.stack([r[keep], q[keep]], axis=1), axis=0)
+        entries = np.unique(np.concatenate(self.comm.allgather(entries)), axis=0)
+        start, stop = A.getOwnershipRange()
+        mine = entries[(entries[:, 0] >= start) & (entries[:, 0] < stop)]
+        indptr = np.searchsorted(mine[:, 0], np.arange(start, stop + 1)).astype(PETSc.IntType)
+        if self.C is not None:
+            self.C.destroy()
+        self.C = PETSc.Mat().create(comm=self.comm)
+        self.C.setSizes(A.getSizes())
+        self.C.setType("aij")
+        self.C.setPreallocationCSR((indptr, mine[:, 1].astype(PETSc.IntType)))
+        self.C.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
+        self._merged = False
+        self.pattern_builds += 1
+        for itf in self.interfaces:
+            itf.pairs_changed = False
+
+    def add_tangent(self, A: PETSc.Mat) -> None:
+        """A += C, the tangent of the contact forces of the last :meth:`add_force`."""
+        if self.C is None or any(itf.pairs_changed for itf in self.interfaces):
+            self._build_pattern(A)
+        self.C.zeroEntries()
+        for itf, (dofs, K, (s, m)) in zip(self.interfaces, self._blocks):
+            if len(s):
+                d = self._pair_dofs(itf, s, m).astype(PETSc.IntType)
+                self.C.setValuesRCV(d, d, K, addv=PETSc.InsertMode.ADD_VALUES)
+        self.C.assemble()
+        lgmap = A.getLGMap()
+        A.axpy(1.0, self.C, PETSc.Mat.Structure.SUBSET if self._merged else PETSc.Mat.Structure.DIFFERENT)
+        if not self._merged:
+            A.setLGMap(*lgmap)  # a new pattern replaces the matrix's internals
+            self._merged = True
+
+    def augment(self) -> bool:
+        """One Uzawa update on every augmented interface that needs it; True if any changed."""
+        changed = [itf.augment() for itf in self.interfaces]
+        return any(changed)
+
+    def begin_step(self) -> None:
+        for itf in self.interfaces:
+            itf.uzawa_updates = 0
+
+    def checkpoint(self):
+        return [itf.multiplier.copy() for itf in self.interfaces]
+
+    def restore(self, cp) -> None:
+        for itf, lam in zip(self.interfaces, cp):
+            itf.multiplier[:] = lam
+
+    def destroy(self) -> None:
+        if self.C is not None:
+            self.C.destroy()

@@ -1,0 +1,156 @@
+"""2D node-to-segment contact through the scene: patch test (Taylor & Papadopoulos 1991), laws, errors."""
+import gmsh
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import dolfinx_corot as dc
+
+comm = MPI.COMM_WORLD
+E, NU, P = 1.0, 0.3, 0.01  # B5_contact_patch_test.json (plane strain)
+
+
+def _two_blocks(n_low, n_up, ny=3):
+    """Unit blocks [0,1]² and [0,1]×[1,2] with n_low and n_up quadrilaterals along x: the
+    interface y = 1 has non-matching nodes (one mesh, two bodies)."""
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        g = gmsh.model.geo
+
+        def block(y0, n):
+            pts = [g.addPoint(x, y, 0) for x, y in ((0, y0), (1, y0), (1, y0 + 1), (0, y0 + 1))]
+            ls = [g.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
+            s = g.addPlaneSurface([g.addCurveLoop(ls)])
+            for line, m in zip(ls, (n, ny, n, ny)):
+                g.mesh.setTransfiniteCurve(line, m + 1)
+            g.mesh.setTransfiniteSurface(s)
+            g.mesh.setRecombine(2, s)
+            return s, ls
+
+        s1, l1 = block(0.0, n_low)
+        s2, l2 = block(1.0, n_up)
+        g.synchronize()
+        for dim, tags, name in ((2, [s1], "lower"), (2, [s2], "upper"), (1, [l1[0]], "base"),
+                                (1, [l1[2]], "lower_top"), (1, [l2[0]], "upper_bottom"), (1, [l2[2]], "top"),
+                                (1, [l1[3], l2[3]], "left")):
+            t = gmsh.model.addPhysicalGroup(dim, tags)
+            gmsh.model.setPhysicalName(dim, t, name)
+        gmsh.model.mesh.generate(2)
+    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm
+
+
+def _patch(n_low, n_up, law, symmetric):
+    tm = _two_blocks(n_low, n_up)
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+    sc.fix(b, "base", dofs=("uy",))
+    sc.fix(b, "left", dofs=("ux",))
+    sc.load(b, "top", traction=(0.0, -P))
+    sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), law=law, symmetric=symmetric)
+    sc.monitor_reaction("base", b, "base")
+    res = dc.solve(sc, dc.LoadControl(steps=1))
+    X, u = sc.model.nodes()  # rank 0: all nodes in a partition-independent order
+    return sc, res, X, u
+
+
+def _linear_field_error(X, u):
+    """Largest deviation of u from the best linear field of each block, relative to max |u|:
+    the exact solution is homogeneous (linear displacements) in both blocks."""
+    worst = 0.0
+    for inside in (X[:, 1] < 1.0 - 1e-12, X[:, 1] > 1.0 + 1e-12):
+        lower = np.isclose(X[:, 1], 1.0) & (np.arange(len(X)) >= 0)
+        A = np.column_stack([np.ones(inside.sum()), X[inside, 0], X[inside, 1]])
+        for k in range(2):
+            coef, *_ = np.linalg.lstsq(A, u[inside, k], rcond=None)
+            worst = max(worst, np.abs(A @ coef - u[inside, k]).max() / np.abs(u).max())
+    return worst
+
+
+@pytest.mark.parametrize("n_low,n_up", [(3, 4), (5, 7)])
+def test_symmetric_contact_passes_the_patch_test(n_low, n_up):
+    """Two-pass contact with augmented-Lagrangian enforcement transmits a uniform pressure through
+    a non-matching interface exactly: both blocks deform homogeneously (to 1e-8)."""
+    sc, res, X, u = _patch(n_low, n_up, dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4), True)
+    assert abs(res.history.column("base_Fy")[-1] - P) < 1e-10 * P
+    if comm.rank == 0:
+        assert _linear_field_error(X, u) < 1e-8
+    assert res.history.rows[-1]["uzawa_updates"] <= 5
+
+
+def test_one_pass_contact_fails_the_patch_test_as_known():
+    """Single-pass node-to-segment contact on non-matching meshes does not transmit a uniform
+    pressure (Taylor & Papadopoulos 1991): the deviation from homogeneity is O(1e-3) here."""
+    sc, res, X, u = _patch(5, 7, dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4), False)
+    assert abs(res.history.column("base_Fy")[-1] - P) < 1e-10 * P
+    if comm.rank == 0:
+        assert _linear_field_error(X, u) > 1e-4
+
+
+def test_contact_errors_name_the_culprit():
+    tm = _two_blocks(2, 3)
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+    with pytest.raises(dc.GroupNotFoundError, match="nowhere"):
+        sc.contact(slaves=(b, "nowhere"), masters=(b, "lower_top"))
+    with pytest.raises(dc.ContactError, match="upper"):
+        sc.contact(slaves=(b, "upper_bottom"), masters=(b, "upper"))
+    with pytest.raises(ValueError, match="penalty must be positive"):
+        sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), law=dc.Penalty(penalty=-1.0))
+    tm2 = _two_blocks(2, 3)
+    sc2 = dc.Scene()
+    b2 = sc2.add_solid(tm2, material=dc.SaintVenantKirchhoff(E, NU), degree=2)
+    with pytest.raises(dc.ContactError, match="degree 1"):
+        sc2.contact(slaves=(b2, "upper_bottom"), masters=(b2, "lower_top"))
+
+
+@pytest.mark.skipif(comm.size > 1, reason="dense FD check of the assembled system: serial")
+@pytest.mark.parametrize("symmetric", [False, True])
+def test_assembled_contact_tangent_matches_finite_differences(symmetric):
+    """The system's tangent (bodies + contact, constrained rows included) against central
+    differences of its residual at a penetrating, sheared state of the two blocks."""
+    from dolfinx_corot.assembly import make_system
+
+    tm = _two_blocks(3, 4)
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+    sc.fix(b, "base", dofs=("uy",))
+    sc.fix(b, "left", dofs=("ux",))
+    sc.load(b, "top", traction=(0.0, -P))
+    sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"),
+               law=dc.AugmentedLagrangian(), symmetric=symmetric)
+    for itf in sc.interfaces:
+        itf.multiplier[:] = 0.3 * P  # an augmented state
+    system = make_system(sc.model, contacts=sc.interfaces)
+    model = sc.model
+    X = model.V.tabulate_dof_coordinates()
+    u = model.state.x.array.reshape(-1, 2)
+    rng = np.random.default_rng(5)
+    u[:, 1] = np.where(X[:, 1] > 1.0 - 1e-12, -0.02, 0.0) + 0.004 * X[:, 0] * (X[:, 1] > 1 - 1e-12)
+    u[:, 0] = 0.01 * X[:, 1] ** 2
+    u += rng.uniform(-1e-3, 1e-3, u.shape) * (X[:, 0:1] > 1e-12)
+    x0 = model.state.x.array.copy()
+    system.residual(1.0)
+    system.jacobian()
+    K = system.A.convert("dense").getDenseArray().copy()
+    n = len(x0)
+    Kfd = np.zeros((n, n))
+    h = 1e-7
+    for j in range(n):
+        r = []
+        for sign in (1, -1):
+            model.state.x.array[:] = x0
+            model.state.x.array[j] += sign * h
+            system.residual(1.0)
+            r.append(system.b.array.copy())
+        Kfd[:, j] = -(r[0] - r[1]) / (2 * h)
+    model.state.x.array[:] = x0
+    fixed = np.concatenate([bc.dof_indices()[0] for bc in system.bcs])
+    free = np.setdiff1d(np.arange(n), fixed)
+    sub = np.ix_(free, free)
+    assert system.contact.interfaces[0].active.max() >= 0
+    assert np.abs(K[sub] - Kfd[sub]).max() < 1e-6 * np.abs(K[sub]).max()
+    system.destroy()

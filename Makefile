@@ -29,6 +29,8 @@ bench: setup
 	mpirun -n 2 $(PY) benchmarks/block3d.py
 	$(PY) benchmarks/block3d.py --mesh 320 32 32   # 10⁶ dofs: about 10 minutes, 8 GB
 	mpirun -n 2 $(PY) benchmarks/block3d.py --mesh 320 32 32
+	$(PY) benchmarks/contact_search.py             # 10⁴, 10⁵, 10⁶ slaves and segments
+	$(PY) benchmarks/contact_effects.py            # an idle interface's cost
 
 # numba's on-disk cache does not see edits of inlined callees in other modules
 clean-cache:

@@ -144,8 +144,10 @@ class System:
             self.ksp.setType("cg" if symmetric else "gmres")
             if PETSc.Sys.hasExternalPackage("ml"):
                 pc.setType("ml")
+                # aggregation across rank boundaries (MIS) pays on several ranks, not on one
                 defaults = {"pc_ml_nullspace": "user", "mg_levels_ksp_type": "chebyshev",
-                            "mg_levels_pc_type": "jacobi"}
+                            "mg_levels_pc_type": "jacobi",
+                            "pc_ml_CoarsenScheme": "MIS" if self.comm.size > 1 else "Uncoupled"}
                 options = PETSc.Options()
                 for key, value in defaults.items():
                     if not options.hasName(options_prefix + key):
@@ -365,6 +367,8 @@ class System:
 
     def begin_step(self) -> None:
         """Start summing the corrections of a new step (see :meth:`step_increment_norm`)."""
+        if self.contact is not None:
+            self.contact.begin_newton()
         with self.step_dx.localForm() as s:
             s.set(0.0)
 

@@ -154,3 +154,100 @@ def test_assembled_contact_tangent_matches_finite_differences(symmetric):
     assert system.contact.interfaces[0].active.max() >= 0
     assert np.abs(K[sub] - Kfd[sub]).max() < 1e-6 * np.abs(K[sub]).max()
     system.destroy()
+
+
+def _slider(n_low=24, n_up=4):
+    """A unit block (n_up elements along x) on a 4-wide base block (n_low segments on its top)."""
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        g = gmsh.model.geo
+
+        def block(x0, y0, w, n, ny=2):
+            pts = [g.addPoint(x, y, 0) for x, y in ((x0, y0), (x0 + w, y0), (x0 + w, y0 + 1), (x0, y0 + 1))]
+            ls = [g.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
+            s = g.addPlaneSurface([g.addCurveLoop(ls)])
+            for line, m in zip(ls, (n, ny, n, ny)):
+                g.mesh.setTransfiniteCurve(line, m + 1)
+            g.mesh.setTransfiniteSurface(s)
+            g.mesh.setRecombine(2, s)
+            return s, ls
+
+        s1, l1 = block(0.0, 0.0, 4.0, n_low)
+        s2, l2 = block(0.5, 1.0, 1.0, n_up)
+        g.synchronize()
+        for dim, tags, name in ((2, [s1], "base_block"), (2, [s2], "slider"), (1, [l1[0]], "base"),
+                                (1, [l1[2]], "base_top"), (1, [l2[0]], "slider_bottom"), (1, [l2[2]], "top")):
+            t = gmsh.model.addPhysicalGroup(dim, tags)
+            gmsh.model.setPhysicalName(dim, t, name)
+        gmsh.model.mesh.generate(2)
+    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm
+
+
+@pytest.mark.parametrize("press", [0.01, 0.0], ids=["pressed", "grazing"])
+def test_block_slides_over_many_segments_without_friction(press):
+    """The slider's top is pushed 2.2 along x (its bottom nodes cross 13 base segments each, and
+    sit exactly on base vertices on the way) while pressed down by a settlement of the top, or
+    only touching (grazing contact: zero gaps throughout). The base is 1000 times stiffer, so
+    its top stays flat: without friction the horizontal force is nil (the normals tilt by the
+    indentation only) and the vertical force constant; every step converges without cuts."""
+    tm = _slider()
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+    sc.add_solid(tm, "base_block", material=dc.SaintVenantKirchhoff(1000 * E, NU), degree=1)
+    sc.fix(b, "base")
+    sc.prescribe(b, "top", ux=2.2)
+    sc.prescribe(b, "top", amplitude=dc.Amplitude(((0.0, 0.0), (1 / 22, 1.0), (1.0, 1.0))),
+                 uy=-press * (1 - NU**2) / E if press else 0.0)  # settled in the first step
+    sc.contact(slaves=(b, "slider_bottom"), masters=(b, "base_top"), law=dc.AugmentedLagrangian())
+    sc.monitor_reaction("top", b, "top")
+    res = dc.solve(sc, dc.LoadControl(steps=22))
+    h = res.history
+    assert h.column("cuts").sum() == 0
+    assert h.column("iterations").max() <= 15, h.column("iterations")
+    Fy = h.column("top_Fy")
+    if press:
+        # the settlement presses the slider down with p · width (ε-dependent by the penetration
+        # the augmented Lagrangian removes), constant while it slides
+        assert abs(abs(Fy[0]) - press) < 0.05 * press and np.ptp(Fy) < 1e-4 * abs(Fy[0]), Fy
+        assert np.abs(h.column("top_Fx")).max() < 1e-3 * abs(Fy[0])
+    else:
+        assert np.abs(Fy).max() < 1e-12 and np.abs(h.column("top_Fx")).max() < 1e-12
+    itf = sc.interfaces[0]
+    assert itf.active.max() >= 0
+
+
+@pytest.mark.parametrize("scale", [1e-2, 1.0, 1e4])
+def test_penalty_from_a_hundredth_to_ten_thousand_times_the_default(scale):
+    """Penalty contact converges for penalties 1e-2 … 1e4 times the default: equilibrium is exact
+    and the penetration is the pressure over the penalty (p/ε), whatever ε."""
+    default = dc.Penalty().factor
+    sc, res, X, u = _patch(3, 4, dc.Penalty(factor=scale * default), False)
+    assert abs(res.history.column("base_Fy")[-1] - P) < 1e-10 * P
+    assert res.history.column("cuts").sum() == 0
+    itf = sc.interfaces[0]
+    s, g = itf.gaps()
+    depth = comm.allreduce(float(np.max(-g, initial=0.0)), op=MPI.MAX)
+    assert 0.5 < depth * itf.penalty / P < 2.0, (depth, itf.penalty)
+
+
+def test_swapping_the_bodies_of_symmetric_contact_changes_nothing():
+    """Two-pass contact declared (upper on lower) or (lower on upper): same interfaces, same
+    numbers."""
+    law = dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4)
+    runs = []
+    for slaves, masters in (("upper_bottom", "lower_top"), ("lower_top", "upper_bottom")):
+        tm = _two_blocks(3, 4)
+        sc = dc.Scene()
+        b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+        sc.fix(b, "base", dofs=("uy",))
+        sc.fix(b, "left", dofs=("ux",))
+        sc.load(b, "top", traction=(0.0, -P))
+        sc.contact(slaves=(b, slaves), masters=(b, masters), law=law, symmetric=True)
+        dc.solve(sc, dc.LoadControl(steps=1))
+        runs.append(sc.model.nodes()[1])
+    if comm.rank == 0:
+        assert np.abs(runs[0] - runs[1]).max() < 1e-10 * np.abs(runs[0]).max()

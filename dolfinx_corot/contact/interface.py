@@ -30,6 +30,7 @@ Laws (Wriggers 2006, §6.2 and §10.3; Simo & Laursen 1992):
 from __future__ import annotations
 
 import logging
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -174,7 +175,7 @@ class Interface:
             self.penalty = law.factor * min(moduli) / self.h
         self.multiplier = np.zeros(len(self.area))
         self.margin = 0.5 * self.h
-        self.touch = 1e-12 * self.h  # a gap below this is closed (round-off of touching bodies)
+        self.touch = 1e-6 * self.h  # a gap below this keeps the penalty stiffness (no force)
         self.uzawa_updates = 0
 
     # -- binding to a system ---------------------------------------------------------
@@ -198,6 +199,8 @@ class Interface:
         self.pairs_changed = True
         self.K = None
         self.active = np.full(n, -1)
+        self.frozen = False
+        self._assigned = None
 
     def _positions(self, surf) -> np.ndarray:
         u = surf["model"].state.x.array[surf["ldofs"]]
@@ -236,10 +239,17 @@ class Interface:
             self._forces = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 6)))
             return (np.zeros((0, 6), dtype=np.int64), np.zeros((0, 6)), np.zeros((0, 6, 6)),
                     (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)))
-        # narrow phase over this rank's candidates: closest segment per slave
-        segment, xi = narrow_phase(xs, xm[seg[:, 0]], xm[seg[:, 1]], mine_pairs)
+        # narrow phase over this rank's candidates: closest segment per slave; once frozen
+        # (late Newton iterations), a slave keeps its segment: a slave at a master vertex where
+        # the normal turns would otherwise alternate between the two segments
+        if self.frozen and self._assigned is not None:
+            segment = self._assigned
+        else:
+            segment, _ = narrow_phase(xs, xm[seg[:, 0]], xm[seg[:, 1]], mine_pairs)
+            self._assigned = segment
         s = self.mine[segment[self.mine] >= 0]
         m = segment[s]
+        self.active[:] = -1
         self.active[s] = m
         g, xi, p, f, K, _ = node_to_segment(xs[s], xm[seg[m, 0]], xm[seg[m, 1]], self.multiplier[s],
                                            np.full(len(s), self.penalty), self.area[s], True, self.touch)
@@ -305,7 +315,9 @@ class Interface:
 
 class ContactSet:
     """The interfaces of a scene bound to one system: adds their forces to f_int and their
-    tangent to the system matrix through a COO matrix over the candidate pairs."""
+    tangent to the system matrix through a matrix over the candidate pairs."""
+
+    FREEZE_AFTER = 6
 
     def __init__(self, interfaces, system):
         self.interfaces = list(interfaces)
@@ -316,16 +328,28 @@ class ContactSet:
         self._merged = False
         self._blocks = []
         self.pattern_builds = 0
+        self.time = 0.0  # s spent in contact search, kernels and assembly
+
+    def begin_newton(self) -> None:
+        """A Newton solve starts: slaves may choose their master segments again."""
+        self.evaluations = 0
 
     def add_force(self, fint: PETSc.Vec) -> None:
-        """Evaluate every interface at the current configuration; fint += contact forces."""
+        """Evaluate every interface at the current configuration; fint += contact forces.
+
+        After ``FREEZE_AFTER`` evaluations of one Newton solve the slaves keep their master
+        segments (the search still runs: the pattern follows the bodies)."""
+        t = time.perf_counter()
         self._blocks = []
+        self.evaluations = getattr(self, "evaluations", 0) + 1
         for itf in self.interfaces:
+            itf.frozen = self.evaluations > self.FREEZE_AFTER
             dofs, f, K, pairs = itf.evaluate()
             self._blocks.append((dofs, K, pairs))
             fint.setValues(dofs.ravel().astype(PETSc.IntType), f.ravel(), addv=PETSc.InsertMode.ADD_VALUES)
         fint.assemblyBegin()
         fint.assemblyEnd()
+        self.time += time.perf_counter() - t
 
     def _pair_dofs(self, itf, slaves, segments) -> np.ndarray:
         """Global dofs (k, 6) of slave–segment pairs, −1 on constrained dofs (PETSc skips them)."""
@@ -363,7 +387,17 @@ class ContactSet:
             itf.pairs_changed = False
 
     def add_tangent(self, A: PETSc.Mat) -> None:
-        """A += C, the tangent of the contact forces of the last :meth:`add_force`."""
+        """A += C, the tangent of the contact forces of the last :meth:`add_force` (nothing while
+        no rank has a candidate pair: bodies far apart cost a search, no matrix work)."""
+        t = time.perf_counter()
+        try:
+            self._add_tangent(A)
+        finally:
+            self.time += time.perf_counter() - t
+
+    def _add_tangent(self, A: PETSc.Mat) -> None:
+        if not self.comm.allreduce(sum(len(itf.candidates) for itf in self.interfaces), op=MPI.SUM):
+            return
         if self.C is None or any(itf.pairs_changed for itf in self.interfaces):
             self._build_pattern(A)
         self.C.zeroEntries()

@@ -151,6 +151,8 @@ class Interface:
     (each a (part, boundary group name) pair). The symmetric (two-pass) contact of two
     deformable bodies is two interfaces, one each way."""
 
+    XI_TOLERANCE = 0.05  # projection this far (× segment length) beyond an end still counts as on it
+
     def __init__(self, slaves, masters, law: Penalty):
         if not isinstance(law, Penalty):
             raise TypeError(f"contact law must be dc.Penalty or dc.AugmentedLagrangian, got {type(law).__name__}")
@@ -245,7 +247,11 @@ class Interface:
         if self.frozen and self._assigned is not None:
             segment = self._assigned
         else:
-            segment, _ = narrow_phase(xs, xm[seg[:, 0]], xm[seg[:, 1]], mine_pairs)
+            segment, xi = narrow_phase(xs, xm[seg[:, 0]], xm[seg[:, 1]], mine_pairs)
+            # a slave whose closest point is a segment's end lies in the cone of a convex master
+            # vertex, outside the master body: no contact (the extended segment line would
+            # report a spurious penetration)
+            segment = np.where((xi >= -self.XI_TOLERANCE) & (xi <= 1.0 + self.XI_TOLERANCE), segment, -1)
             self._assigned = segment
         s = self.mine[segment[self.mine] >= 0]
         m = segment[s]

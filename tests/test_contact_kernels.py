@@ -80,3 +80,50 @@ def test_separated_pair_is_inactive():
     xs, x1, x2 = np.array([[0.5, -0.1]]), np.array([[0.0, 0.0]]), np.array([[1.0, 0.0]])
     g, xi, p, f, K, W = node_to_segment(xs, x1, x2, np.zeros(1), np.array([1e3]), np.array([1.0]), True)
     assert g[0] == pytest.approx(0.1) and p[0] == 0 and not f.any() and not K.any() and W[0] == 0
+
+
+@pytest.mark.parametrize("multiplier", [0.0, 2.0])
+def test_node_to_vertex_force_and_tangent_match_finite_differences(multiplier):
+    from dolfinx_corot.contact.kernels2d import node_to_vertex
+
+    rng = np.random.default_rng(11)
+    for trial in range(6):
+        xv = rng.uniform(-1, 1, 2)
+        nbar = rng.normal(size=2)
+        nbar /= np.linalg.norm(nbar)
+        d = -rng.uniform(0.01, 0.1) * (nbar + 0.3 * rng.normal(size=2))  # inside: g < 0
+        x0 = np.concatenate([xv + d, xv])
+        eps, area, lam = np.array([rng.uniform(10, 1000)]), np.array([0.7]), np.array([multiplier])
+
+        def ev(x, tangent=False):
+            return node_to_vertex(x[None, 0:2], x[None, 2:4], nbar[None], lam, eps, area, tangent)
+
+        g, p, f, K = ev(x0, True)
+        assert g[0] < 0 and p[0] > 0
+        h = 1e-7
+        fd_K = np.zeros((4, 4))
+        fd_f = np.zeros(4)
+        for j in range(4):
+            e = np.zeros(4)
+            e[j] = h
+            fd_K[:, j] = (ev(x0 + e)[2][0] - ev(x0 - e)[2][0]) / (2 * h)
+            # f = ∂Φ/∂x with Φ = A/(2ε) p²
+            Wp = area[0] / (2 * eps[0]) * ev(x0 + e)[1][0] ** 2
+            Wm = area[0] / (2 * eps[0]) * ev(x0 - e)[1][0] ** 2
+            fd_f[j] = (Wp - Wm) / (2 * h)
+        assert np.abs(f[0] - fd_f).max() < 1e-6 * np.abs(f[0]).max()
+        assert np.abs(K[0] - fd_K).max() < 1e-6 * np.abs(K[0]).max()
+
+
+def test_node_to_vertex_continues_node_to_segment_at_the_segment_end():
+    """At ξ = 1 the vertex gap, force and normal stiffness equal the segment's."""
+    from dolfinx_corot.contact.kernels2d import node_to_vertex
+
+    x1, x2 = np.array([0.0, 0.0]), np.array([1.0, 0.0])
+    xs = np.array([1.0, 0.02])       # below the segment's end (the body is above: n = (0, -1))
+    lam, eps, area = np.array([1.0]), np.array([100.0]), np.array([0.5])
+    g, xi, p, f, K, W = node_to_segment(xs[None], x1[None], x2[None], lam, eps, area, True)
+    assert abs(xi[0] - 1.0) < 1e-15
+    gv, pv, fv, Kv = node_to_vertex(xs[None], x2[None], np.array([[0.0, -1.0]]), lam, eps, area, True)
+    assert abs(gv[0] - g[0]) < 1e-15 and abs(pv[0] - p[0]) < 1e-12
+    assert np.abs(fv[0] - f[0][[0, 1, 4, 5]]).max() < 1e-12

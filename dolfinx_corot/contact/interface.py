@@ -37,7 +37,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from .kernels2d import node_to_segment
+from .kernels2d import node_to_segment, node_to_vertex
 from .search import broad_phase, narrow_phase
 
 logger = logging.getLogger(__name__)
@@ -151,7 +151,7 @@ class Interface:
     (each a (part, boundary group name) pair). The symmetric (two-pass) contact of two
     deformable bodies is two interfaces, one each way."""
 
-    XI_TOLERANCE = 0.05  # projection this far (× segment length) beyond an end still counts as on it
+    XI_TOLERANCE = 0.05  # beyond a free end of the master surface: this far (× length) still on it
 
     def __init__(self, slaves, masters, law: Penalty):
         if not isinstance(law, Penalty):
@@ -175,6 +175,7 @@ class Interface:
                 E, nu = m.E.x.array, m.nu.x.array
                 moduli.append(m.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN))
             self.penalty = law.factor * min(moduli) / self.h
+        self.valence = np.bincount(sm.ravel(), minlength=len(Xm))  # segments at each master node
         self.multiplier = np.zeros(len(self.area))
         self.margin = 0.5 * self.h
         self.touch = 1e-6 * self.h  # a gap below this keeps the penalty stiffness (no force)
@@ -241,30 +242,67 @@ class Interface:
             self._forces = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 6)))
             return (np.zeros((0, 6), dtype=np.int64), np.zeros((0, 6)), np.zeros((0, 6, 6)),
                     (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)))
-        # narrow phase over this rank's candidates: closest segment per slave; once frozen
-        # (late Newton iterations), a slave keeps its segment: a slave at a master vertex where
-        # the normal turns would otherwise alternate between the two segments
-        if self.frozen and self._assigned is not None:
-            segment = self._assigned
-        else:
+        # narrow phase over this rank's candidates: closest segment per slave, and where on it:
+        # inside (node-to-segment), or at one of its ends (node-to-vertex when a second segment
+        # shares that vertex; at a free end of the surface the segment's line, up to a small
+        # tolerance). Once frozen (late Newton iterations) a slave keeps its assignment: one at
+        # a vertex where the normal turns would otherwise alternate without converging.
+        if not (self.frozen and self._assigned is not None):
             segment, xi = narrow_phase(xs, xm[seg[:, 0]], xm[seg[:, 1]], mine_pairs)
-            # a slave whose closest point is a segment's end lies in the cone of a convex master
-            # vertex, outside the master body: no contact (the extended segment line would
-            # report a spurious penetration)
-            segment = np.where((xi >= -self.XI_TOLERANCE) & (xi <= 1.0 + self.XI_TOLERANCE), segment, -1)
-            self._assigned = segment
+            mode = np.zeros(len(segment), dtype=np.int64)             # 0: on the segment
+            end = np.where(xi < 0.0, 0, 1)
+            beyond = (segment >= 0) & ((xi < 0.0) | (xi > 1.0))
+            vertex = np.where(beyond, seg[np.maximum(segment, 0), end], -1)
+            shared = beyond & (self.valence[np.maximum(vertex, 0)] >= 2)
+            mode[shared] = 1 + end[shared]                           # 1, 2: at vertex a, b
+            free_end = beyond & ~shared & ((xi < -self.XI_TOLERANCE) | (xi > 1.0 + self.XI_TOLERANCE))
+            segment = np.where(free_end, -1, segment)
+            self._assigned = (segment, mode)
+        segment, mode = self._assigned
         s = self.mine[segment[self.mine] >= 0]
         m = segment[s]
         self.active[:] = -1
         self.active[s] = m
-        g, xi, p, f, K, _ = node_to_segment(xs[s], xm[seg[m, 0]], xm[seg[m, 1]], self.multiplier[s],
-                                           np.full(len(s), self.penalty), self.area[s], True, self.touch)
-        keep = (self.multiplier[s] - self.penalty * g) >= -self.penalty * self.touch  # closed or touching
+        n = len(s)
+        g = np.zeros(n)
+        f = np.zeros((n, 6))
+        K = np.zeros((n, 6, 6))
+        lam, eps = self.multiplier[s], np.full(n, self.penalty)
+        on = mode[s] == 0
+        if on.any():
+            i = np.flatnonzero(on)
+            g[i], _, _, f[i], K[i], _ = node_to_segment(xs[s[i]], xm[seg[m[i], 0]], xm[seg[m[i], 1]], lam[i],
+                                                       eps[i], self.area[s[i]], True, self.touch)
+        if (~on).any():
+            normals = self._vertex_normals(xm)
+            for k in (1, 2):
+                i = np.flatnonzero(mode[s] == k)
+                if not len(i):
+                    continue
+                v = seg[m[i], k - 1]
+                gv, _, fv, Kv = node_to_vertex(xs[s[i]], xm[v], normals[v], lam[i], eps[i], self.area[s[i]],
+                                               True, self.touch)
+                idx = np.array([0, 1, 2, 3]) if k == 1 else np.array([0, 1, 4, 5])
+                g[i] = gv
+                f[np.ix_(i, idx)] = fv
+                K[np.ix_(i, idx, idx)] = Kv
+        keep = (lam - self.penalty * g) >= -self.penalty * self.touch  # closed or touching
         dofs = np.hstack([self.slave["gdofs"][s], self.master["gdofs"][seg[m, 0]],
                           self.master["gdofs"][seg[m, 1]]])
         self._last = (s, g)
         self._forces = (s[keep], m[keep], f[keep])
         return dofs[keep], f[keep], K[keep], (s[keep], m[keep])
+
+    def _vertex_normals(self, xm: np.ndarray) -> np.ndarray:
+        """Unit averaged outward normals (n_master, 2) of the master nodes (current)."""
+        seg = self.master["segments"]
+        t = xm[seg[:, 1]] - xm[seg[:, 0]]
+        n = np.column_stack([t[:, 1], -t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
+        out = np.zeros_like(xm)
+        np.add.at(out, seg[:, 0], n)
+        np.add.at(out, seg[:, 1], n)
+        norm = np.linalg.norm(out, axis=1)
+        return out / np.where(norm > 0.0, norm, 1.0)[:, None]
 
     def gaps(self) -> tuple[np.ndarray, np.ndarray]:
         """(slave indices, gaps) of this rank's slaves that have a master segment now."""

@@ -133,3 +133,60 @@ def node_to_segment(xs, x1, x2, multiplier, penalty, area, with_tangent, touch=0
                 K[i, r, c] = s
                 K[i, c, r] = s
     return g, xi, p, f, K, energy
+
+
+@numba.njit(cache=True)
+def node_to_vertex(xs, xv, normal, multiplier, penalty, area, with_tangent, touch=0.0):
+    r"""Contact of slaves with master vertices (the closest point of the master surface is a
+    vertex shared by two segments).
+
+    The gap is the distance to the vertex, signed by the side of the vertex's averaged
+    normal: :math:`g = s\,|\mathbf x_s-\mathbf x_v|`, :math:`s = \mathrm{sign}((\mathbf x_s-\mathbf x_v)\cdot\bar{\mathbf n})`;
+    :math:`\partial g/\partial(\mathbf x_s, \mathbf x_v) = (\boldsymbol\nu, -\boldsymbol\nu)` with
+    :math:`\boldsymbol\nu = s\,\mathbf d/|\mathbf d|`, and
+    :math:`\partial^2 g = \frac{s}{|\mathbf d|}(\mathbf I-\hat{\mathbf d}\hat{\mathbf d}^T)\begin{pmatrix}1&-1\\-1&1\end{pmatrix}`.
+    At the edge of a segment's region (ξ = 0 or 1) this gap and its gradient equal the
+    segment's, so a slave passes from segment to vertex to segment without a jump.
+
+    xs, xv: (k, 2); normal: (k, 2) averaged unit normals at the vertices; multiplier,
+    penalty, area: (k,). Returns g, p: (k,); f: (k, 4) on (x_s, x_v); K: (k, 4, 4)."""
+    k = xs.shape[0]
+    g = np.empty(k)
+    p = np.zeros(k)
+    f = np.zeros((k, 4))
+    K = np.zeros((k, 4, 4))
+    for i in range(k):
+        dx = xs[i, 0] - xv[i, 0]
+        dy = xs[i, 1] - xv[i, 1]
+        dist = np.sqrt(dx * dx + dy * dy)
+        s = 1.0 if dx * normal[i, 0] + dy * normal[i, 1] >= 0.0 else -1.0
+        g[i] = s * dist
+        eps = penalty[i]
+        pi = multiplier[i] - eps * g[i]
+        if pi < -eps * touch or dist == 0.0:
+            continue
+        pi = max(pi, 0.0)
+        p[i] = pi
+        a = area[i]
+        nux = s * dx / dist
+        nuy = s * dy / dist
+        N = (nux, nuy, -nux, -nuy)
+        for r in range(4):
+            f[i, r] = -a * pi * N[r]
+        if not with_tangent:
+            continue
+        ux = dx / dist
+        uy = dy / dist
+        P = ((1.0 - ux * ux, -ux * uy), (-ux * uy, 1.0 - uy * uy))
+        c = s / dist
+        for r in range(4):
+            for q in range(4):
+                K[i, r, q] = a * eps * N[r] * N[q]
+        for r in range(2):
+            for q in range(2):
+                h = a * pi * c * P[r][q]
+                K[i, r, q] -= h
+                K[i, r + 2, q + 2] -= h
+                K[i, r, q + 2] += h
+                K[i, r + 2, q] += h
+    return g, p, f, K

@@ -70,8 +70,10 @@ def test_restart_under_mpi_matches_serial(tmp_path):
 
 @pytest.mark.mpi
 def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
-    """Parts on several meshes (shared nodes across ranks), quadrilateral membranes and continua
-    (GAMG, reactions, exact homogeneous states) on 2 ranks."""
+    """Parts on several meshes (shared nodes across ranks), quadrilateral membranes, continua
+    (AMG, reactions, exact homogeneous states) and contact (patch test, sliding, penalty range) on
+    2 ranks."""
     out = _run(["mpirun", "-n", "2", sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--color=no",
-                "tests/test_coupled.py", "tests/test_membrane_quad.py", "tests/test_continuum.py"], tmp_path)
+                "tests/test_coupled.py", "tests/test_membrane_quad.py", "tests/test_continuum.py",
+                "tests/test_contact.py"], tmp_path)
     assert out.count(" passed") == 2 and "failed" not in out and "error" not in out.lower()

@@ -156,8 +156,9 @@ def test_assembled_contact_tangent_matches_finite_differences(symmetric):
     system.destroy()
 
 
-def _slider(n_low=24, n_up=4):
-    """A unit block (n_up elements along x) on a 4-wide base block (n_low segments on its top)."""
+def _slider(n_low=24, n_up=4, gap=0.0):
+    """A unit block (n_up elements along x) on a 4-wide base block (n_low segments on its top),
+    ``gap`` above it."""
     if comm.rank == 0:
         gmsh.initialize()
         gmsh.option.setNumber("General.Terminal", 0)
@@ -174,7 +175,7 @@ def _slider(n_low=24, n_up=4):
             return s, ls
 
         s1, l1 = block(0.0, 0.0, 4.0, n_low)
-        s2, l2 = block(0.5, 1.0, 1.0, n_up)
+        s2, l2 = block(0.5, 1.0 + gap, 1.0, n_up)
         g.synchronize()
         for dim, tags, name in ((2, [s1], "base_block"), (2, [s2], "slider"), (1, [l1[0]], "base"),
                                 (1, [l1[2]], "base_top"), (1, [l2[0]], "slider_bottom"), (1, [l2[2]], "top")):
@@ -251,3 +252,27 @@ def test_swapping_the_bodies_of_symmetric_contact_changes_nothing():
         runs.append(sc.model.nodes()[1])
     if comm.rank == 0:
         assert np.abs(runs[0] - runs[1]).max() < 1e-10 * np.abs(runs[0]).max()
+
+
+def test_an_idle_interface_changes_nothing_and_builds_no_matrix():
+    """Bodies that never come near: the interface costs a search per residual, no contact matrix
+    is built, and the solution equals that of the scene without the interface (to round-off)."""
+    from dolfinx_corot.assembly import make_system
+
+    results = []
+    for with_contact in (False, True):
+        tm = _slider(n_low=6, n_up=3, gap=0.5)  # beyond the search margin (half a segment)
+        sc = dc.Scene()
+        b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+        sc.fix(b, "base")
+        sc.prescribe(b, "top", ux=0.3, uy=0.5)  # the slider is moved away from the base
+        if with_contact:
+            sc.contact(slaves=(b, "slider_bottom"), masters=(b, "base_top"), symmetric=True)
+        system = make_system(sc.model, contacts=sc.interfaces)
+        dc.solve(sc, dc.LoadControl(steps=3), system=system)
+        if with_contact:
+            assert system.contact.C is None and system.contact.time < 0.5
+        results.append(sc.model.nodes()[1])
+        system.destroy()
+    if comm.rank == 0:
+        assert np.abs(results[0] - results[1]).max() < 1e-14, np.abs(results[0] - results[1]).max()

@@ -76,9 +76,12 @@ def boundary_surface(part, where: str) -> dict:
     in the model, "segments": (m, 2) node indices with the body on the left}."""
     model = part.model
     from ..continuum.solid import Solid
+    from ..parts import Frame2D
 
+    if isinstance(model, Frame2D):
+        return _beam_surface(model, where)
     if not isinstance(model, Solid) or model.gdim != 2:
-        raise ContactError(f"contact surface '{where}': only boundaries of 2D solids are supported so far "
+        raise ContactError(f"contact surface '{where}': only 2D solids and 2D beams are supported so far "
                            f"(got a {type(model).__name__} in {model.gdim}D)")
     if model.degree != 1:
         raise ContactError(f"contact surface '{where}': node-to-segment contact needs linear solids "
@@ -137,6 +140,40 @@ def boundary_surface(part, where: str) -> dict:
     return {"keys": keys, "X": X, "local": own_pos, "ldofs": ldofs, "segments": segments, "model": model}
 
 
+def _gather_surface(model, seg_blocks: np.ndarray, Xdof: np.ndarray, where: str) -> dict:
+    """The arrays of :func:`boundary_surface` from this rank's segments (local dof blocks)."""
+    V = model.V
+    bs = V.dofmap.index_map_bs
+    imap = V.dofmap.index_map
+    gblocks = imap.local_to_global(np.arange(imap.size_local + imap.num_ghosts, dtype=np.int32))
+    comm = model.comm
+    seg_keys = np.concatenate(comm.allgather(gblocks[seg_blocks].reshape(-1, 2)))
+    if len(seg_keys) == 0:
+        raise ContactError(f"contact surface '{where}' has no segments")
+    keys, segments = np.unique(seg_keys, return_inverse=True)
+    segments = segments.reshape(-1, 2)
+    X = np.zeros((len(keys), 2))
+    own_blocks = np.flatnonzero(np.isin(gblocks[: imap.size_local], keys))
+    own_pos = np.searchsorted(keys, gblocks[own_blocks])
+    for pos, x in zip(comm.allgather(own_pos), comm.allgather(Xdof[own_blocks])):
+        X[pos] = x
+    ldofs = (own_blocks[:, None] * bs + np.arange(2)[None, :]).astype(np.int32)
+    return {"keys": keys, "X": X, "local": own_pos, "ldofs": ldofs, "segments": segments, "model": model}
+
+
+def _beam_surface(model, where: str) -> dict:
+    """Nodes and segments (the elements) of the line group ``where`` of a 2D beam part: the beam's
+    axis is the contact line; its nodes may be slaves (their translations take the force)."""
+    tm = model.tmesh
+    cells = tm.cells(where)
+    n_owned = tm.mesh.topology.index_map(1).size_local
+    cells = cells[cells < n_owned]
+    seg_blocks = np.array([model.V.dofmap.cell_dofs(c) for c in cells], dtype=np.int64).reshape(-1, 2)
+    surf = _gather_surface(model, seg_blocks, model.V.tabulate_dof_coordinates()[:, :2], where)
+    surf["beam"] = True
+    return surf
+
+
 def _tributary_lengths(X: np.ndarray, segments: np.ndarray) -> np.ndarray:
     """Half the summed lengths of the segments at each node (the node's share of the boundary)."""
     length = np.linalg.norm(X[segments[:, 1]] - X[segments[:, 0]], axis=1)
@@ -159,6 +196,9 @@ class Interface:
         self.slave_spec, self.master_spec, self.law = slaves, masters, law
         self.slave = boundary_surface(*slaves)
         self.master = boundary_surface(*masters)
+        if self.master.get("beam"):
+            raise ContactError(f"contact '{masters[1]}': beams as master segments are not supported yet "
+                               "(make the beam's nodes the slaves and the other body's boundary the master)")
         self.name = f"{slaves[1]} -> {masters[1]}"
         # slaves: all nodes of the slave group; their tributary lengths on the slave boundary
         self.area = _tributary_lengths(self.slave["X"], self.slave["segments"])
@@ -171,6 +211,8 @@ class Interface:
         else:
             moduli = []
             for surf in (self.slave, self.master):
+                if surf.get("beam"):
+                    continue  # the solid's modulus sets the scale
                 m = surf["model"]
                 E, nu = m.E.x.array, m.nu.x.array
                 moduli.append(m.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN))

@@ -55,10 +55,10 @@ class Solid(PrescribedMotion):
         self.gdim = self.tdim = mesh.geometry.dim
         self.dof_names = ("ux", "uy", "uz")[: self.gdim]
         self.ndof = self.translations = self.gdim
-        self.nodes_per_cell = None
         # Gauss rule: 2p on simplices, 2p + 1 on quadrilaterals/hexahedra ((p + 1)^d points)
         self.quadrature = 2 * degree + (0 if cell in ("triangle", "tetrahedron") else 1)
         self.V = dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", degree))
+        self.nodes_per_cell = self.V.dofmap.dof_layout.num_dofs  # dof blocks per cell
         self.state = dolfinx.fem.Function(self.V, name="displacement")
         Q = dolfinx.fem.FunctionSpace(mesh, ("DG", 0))
         self.E = dolfinx.fem.Function(Q, name="E")
@@ -274,6 +274,20 @@ class Solid(PrescribedMotion):
 
     def displacement_vector(self) -> PETSc.Vec:
         return self.state.vector
+
+    def _input_ids(self) -> np.ndarray:
+        """A key per local dof block (owned and ghost) for :class:`~dolfinx_corot.assembly.DofLayout`:
+        the input (gmsh) node number on linear meshes, so that structures read from the same gmsh
+        model share the solid's nodes; quadratic solids number their blocks apart (never shared)."""
+        imap = self.V.dofmap.index_map
+        n = imap.size_local + imap.num_ghosts
+        if self.degree == 1:
+            mesh = self.V.mesh
+            ids = np.empty(n, dtype=np.int64)
+            geo = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)
+            ids[self.V.dofmap.list.array] = geo[mesh.geometry.dofmap.array]
+            return ids
+        return imap.local_to_global(np.arange(n, dtype=np.int32)).astype(np.int64) + (np.int64(1) << 32)
 
     def checkpoint(self) -> np.ndarray:
         return self.state.x.array.copy()

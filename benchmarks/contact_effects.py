@@ -17,43 +17,21 @@ import json
 import os
 import time
 
-import gmsh
 import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
 from dolfinx_corot.io import output_dir
+from dolfinx_corot.io.mesh import rectangles
 
 comm = MPI.COMM_WORLD
 
 
 def blocks(nx, ny):
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-        groups = {}
-        for k, x0 in enumerate((0.0, 3.0)):
-            pts = [g.addPoint(x, y, 0) for x, y in ((x0, 0), (x0 + 1, 0), (x0 + 1, 1), (x0, 1))]
-            ls = [g.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
-            s = g.addPlaneSurface([g.addCurveLoop(ls)])
-            for line, m in zip(ls, (nx, ny, nx, ny)):
-                g.mesh.setTransfiniteCurve(line, m + 1)
-            g.mesh.setTransfiniteSurface(s)
-            g.mesh.setRecombine(2, s)
-            groups[f"block{k}"] = (2, [s])
-            groups[f"base{k}"] = (1, [ls[0]])
-            groups[f"top{k}"] = (1, [ls[2]])
-            groups[f"inner{k}"] = (1, [ls[1]] if k == 0 else [ls[3]])
-        g.synchronize()
-        for name, (dim, tags) in groups.items():
-            t = gmsh.model.addPhysicalGroup(dim, tags)
-            gmsh.model.setPhysicalName(dim, t, name)
-        gmsh.model.mesh.generate(2)
-    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
-    return tm
+    return rectangles({"block0": (0.0, 0.0, 1.0, 1.0, nx, ny), "block1": (3.0, 0.0, 1.0, 1.0, nx, ny)},
+                      {"base0": [("block0", "bottom")], "top0": [("block0", "top")], "inner0": [("block0", "right")],
+                       "base1": [("block1", "bottom")], "top1": [("block1", "top")], "inner1": [("block1", "left")]},
+                      comm=comm)
 
 
 def run(nx, ny, with_contact):

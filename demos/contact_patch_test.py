@@ -43,12 +43,12 @@ import logging
 import os
 import time
 
-import gmsh
 import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
-from dolfinx_corot.io import output_dir, reference
+from dolfinx_corot.io import output_dir, reference, write_rows
+from dolfinx_corot.io.mesh import rectangles
 
 comm = MPI.COMM_WORLD
 logging.basicConfig(level=logging.WARNING)
@@ -67,34 +67,10 @@ def say(*args):
 
 # %%
 def two_blocks(n_low, n_up, ny=3):
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-
-        def block(y0, n):
-            pts = [g.addPoint(x, y, 0) for x, y in ((0, y0), (1, y0), (1, y0 + 1), (0, y0 + 1))]
-            ls = [g.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
-            s = g.addPlaneSurface([g.addCurveLoop(ls)])
-            for line, m in zip(ls, (n, ny, n, ny)):
-                g.mesh.setTransfiniteCurve(line, m + 1)
-            g.mesh.setTransfiniteSurface(s)
-            g.mesh.setRecombine(2, s)
-            return s, ls
-
-        s1, l1 = block(0.0, n_low)
-        s2, l2 = block(1.0, n_up)
-        g.synchronize()
-        for dim, tags, name in ((2, [s1], "lower"), (2, [s2], "upper"), (1, [l1[0]], "base"),
-                                (1, [l1[2]], "lower_top"), (1, [l2[0]], "upper_bottom"), (1, [l2[2]], "top"),
-                                (1, [l1[3], l2[3]], "left")):
-            t = gmsh.model.addPhysicalGroup(dim, tags)
-            gmsh.model.setPhysicalName(dim, t, name)
-        gmsh.model.mesh.generate(2)
-    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
-    return tm
+    return rectangles({"lower": (0.0, 0.0, 1.0, 1.0, n_low, ny), "upper": (0.0, 1.0, 1.0, 1.0, n_up, ny)},
+                      {"base": [("lower", "bottom")], "lower_top": [("lower", "top")],
+                       "upper_bottom": [("upper", "bottom")], "top": [("upper", "top")],
+                       "left": [("lower", "left"), ("upper", "left")]}, comm=comm)
 
 
 def linear_field_error(X, u):
@@ -146,17 +122,12 @@ for n_low, n_up in ((4, 7), (5, 9)):
 
 # %%
 if comm.rank == 0:
-    import csv
-
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    with open(os.path.join(out, "patch_test.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(os.path.join(out, "patch_test.csv"), rows)
     fig, ax = plt.subplots(figsize=(7, 3.5))
     labels = [f"{r['meshes']}\n{r['method'].replace(', ', chr(10))}" for r in rows]
     ax.bar(range(len(rows)), [max(r["error"], 1e-16) for r in rows], color=["C3", "C2", "C1"] * 2)

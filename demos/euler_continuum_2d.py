@@ -77,29 +77,11 @@ def say(*args):
 # ## The column as a structured gmsh rectangle of quadrilaterals
 
 # %%
-import gmsh  # noqa: E402
+from dolfinx_corot.io.mesh import rectangles  # noqa: E402
 
 
 def column(nx: int, ny: int):
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-        pts = [g.addPoint(x, y, 0.0) for x, y in ((0, 0), (L, 0), (L, H), (0, H))]
-        lines = [g.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
-        s = g.addPlaneSurface([g.addCurveLoop(lines)])
-        for line, n in zip(lines, (nx, ny, nx, ny)):
-            g.mesh.setTransfiniteCurve(line, n + 1)
-        g.mesh.setTransfiniteSurface(s)
-        g.mesh.setRecombine(2, s)
-        g.synchronize()
-        for dim, tags, name in ((2, [s], "column"), (1, [lines[3]], "clamp")):
-            tag = gmsh.model.addPhysicalGroup(dim, tags)
-            gmsh.model.setPhysicalName(dim, tag, name)
-        gmsh.model.mesh.generate(2)
-    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
+    tm = rectangles({"column": (0.0, 0.0, L, H, nx, ny)}, {"clamp": [("column", "left")]}, comm=comm)
     # the imperfection: the bottom corner block at the free end, one element of the
     # coarsest mesh (at least 0.25 m × 0.25 m, so that it does not vanish on fine meshes)
     a, b = max(L / nx, 0.25), max(H / ny, 0.25)

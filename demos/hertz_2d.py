@@ -56,7 +56,8 @@ import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
-from dolfinx_corot.io import output_dir, reference
+from dolfinx_corot.io import output_dir, reference, write_rows
+from dolfinx_corot.io.mesh import name_groups
 
 comm = MPI.COMM_WORLD
 logging.basicConfig(level=logging.WARNING)
@@ -121,11 +122,8 @@ def mesh(h_contact: float, h_foundation: float):
         gmsh.model.mesh.field.setAsBackgroundMesh(7)
         for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
             gmsh.option.setNumber(f"Mesh.{opt}", 0)
-        for dim, tags, name in ((2, [cyl], "cylinder"), (2, [found], "foundation"), (1, [arc], "arc"),
-                                (1, [top], "load"), (1, [axis, faxis], "axis"), (1, [ftop], "foundation_top"),
-                                (1, [fbase], "base")):
-            t = gmsh.model.addPhysicalGroup(dim, tags)
-            gmsh.model.setPhysicalName(dim, t, name)
+        name_groups({"cylinder": (2, [cyl]), "foundation": (2, [found]), "arc": (1, [arc]), "load": (1, [top]),
+                     "axis": (1, [axis, faxis]), "foundation_top": (1, [ftop]), "base": (1, [fbase])})
         gmsh.model.mesh.generate(2)
     tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
     if comm.rank == 0:
@@ -204,17 +202,12 @@ for name, hc, hf in meshes:
 
 # %%
 if comm.rank == 0:
-    import csv
-
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    with open(os.path.join(out, "hertz_2d.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_rows(os.path.join(out, "hertz_2d.csv"), rows)
     fig, axes = plt.subplots(1, 3, figsize=(15, 4))
     shown = {k: results[k] for k in (meshes[0][0], meshes[-1][0])}
     for ax, (name, profiles) in zip(axes, shown.items()):

@@ -1,10 +1,10 @@
 """2D node-to-segment contact through the scene: patch test (Taylor & Papadopoulos 1991), laws, errors."""
-import gmsh
 import numpy as np
 import pytest
 from mpi4py import MPI
 
 import dolfinx_corot as dc
+from dolfinx_corot.io.mesh import rectangles
 
 comm = MPI.COMM_WORLD
 E, NU, P = 1.0, 0.3, 0.01  # B5_contact_patch_test.json (plane strain)
@@ -13,34 +13,10 @@ E, NU, P = 1.0, 0.3, 0.01  # B5_contact_patch_test.json (plane strain)
 def _two_blocks(n_low, n_up, ny=3):
     """Unit blocks [0,1]² and [0,1]×[1,2] with n_low and n_up quadrilaterals along x: the
     interface y = 1 has non-matching nodes (one mesh, two bodies)."""
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-
-        def block(y0, n):
-            pts = [g.addPoint(x, y, 0) for x, y in ((0, y0), (1, y0), (1, y0 + 1), (0, y0 + 1))]
-            ls = [g.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
-            s = g.addPlaneSurface([g.addCurveLoop(ls)])
-            for line, m in zip(ls, (n, ny, n, ny)):
-                g.mesh.setTransfiniteCurve(line, m + 1)
-            g.mesh.setTransfiniteSurface(s)
-            g.mesh.setRecombine(2, s)
-            return s, ls
-
-        s1, l1 = block(0.0, n_low)
-        s2, l2 = block(1.0, n_up)
-        g.synchronize()
-        for dim, tags, name in ((2, [s1], "lower"), (2, [s2], "upper"), (1, [l1[0]], "base"),
-                                (1, [l1[2]], "lower_top"), (1, [l2[0]], "upper_bottom"), (1, [l2[2]], "top"),
-                                (1, [l1[3], l2[3]], "left")):
-            t = gmsh.model.addPhysicalGroup(dim, tags)
-            gmsh.model.setPhysicalName(dim, t, name)
-        gmsh.model.mesh.generate(2)
-    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
-    return tm
+    return rectangles({"lower": (0.0, 0.0, 1.0, 1.0, n_low, ny), "upper": (0.0, 1.0, 1.0, 1.0, n_up, ny)},
+                      {"base": [("lower", "bottom")], "lower_top": [("lower", "top")],
+                       "upper_bottom": [("upper", "bottom")], "top": [("upper", "top")],
+                       "left": [("lower", "left"), ("upper", "left")]}, comm=comm)
 
 
 def _patch(n_low, n_up, law, symmetric):
@@ -159,33 +135,9 @@ def test_assembled_contact_tangent_matches_finite_differences(symmetric):
 def _slider(n_low=24, n_up=4, gap=0.0):
     """A unit block (n_up elements along x) on a 4-wide base block (n_low segments on its top),
     ``gap`` above it."""
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-
-        def block(x0, y0, w, n, ny=2):
-            pts = [g.addPoint(x, y, 0) for x, y in ((x0, y0), (x0 + w, y0), (x0 + w, y0 + 1), (x0, y0 + 1))]
-            ls = [g.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
-            s = g.addPlaneSurface([g.addCurveLoop(ls)])
-            for line, m in zip(ls, (n, ny, n, ny)):
-                g.mesh.setTransfiniteCurve(line, m + 1)
-            g.mesh.setTransfiniteSurface(s)
-            g.mesh.setRecombine(2, s)
-            return s, ls
-
-        s1, l1 = block(0.0, 0.0, 4.0, n_low)
-        s2, l2 = block(0.5, 1.0 + gap, 1.0, n_up)
-        g.synchronize()
-        for dim, tags, name in ((2, [s1], "base_block"), (2, [s2], "slider"), (1, [l1[0]], "base"),
-                                (1, [l1[2]], "base_top"), (1, [l2[0]], "slider_bottom"), (1, [l2[2]], "top")):
-            t = gmsh.model.addPhysicalGroup(dim, tags)
-            gmsh.model.setPhysicalName(dim, t, name)
-        gmsh.model.mesh.generate(2)
-    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
-    return tm
+    return rectangles({"base_block": (0.0, 0.0, 4.0, 1.0, n_low, 2), "slider": (0.5, 1.0 + gap, 1.0, 1.0, n_up, 2)},
+                      {"base": [("base_block", "bottom")], "base_top": [("base_block", "top")],
+                       "slider_bottom": [("slider", "bottom")], "top": [("slider", "top")]}, comm=comm)
 
 
 @pytest.mark.parametrize("press", [0.01, 0.0], ids=["pressed", "grazing"])
@@ -286,25 +238,8 @@ def test_beam_nodes_as_slaves_on_a_soil_block():
     from dolfinx_corot.assembly import make_system
 
     F = 5.0
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-        pts = [g.addPoint(x, y, 0) for x, y in ((0, -1), (4, -1), (4, 0), (0, 0))]
-        ls = [g.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
-        s = g.addPlaneSurface([g.addCurveLoop(ls)])
-        for line, m in zip(ls, (16, 4, 16, 4)):
-            g.mesh.setTransfiniteCurve(line, m + 1)
-        g.mesh.setTransfiniteSurface(s)
-        g.mesh.setRecombine(2, s)
-        g.synchronize()
-        for dim, tags, name in ((2, [s], "soil"), (1, [ls[0]], "soil_base"), (1, [ls[2]], "soil_top")):
-            t = gmsh.model.addPhysicalGroup(dim, tags)
-            gmsh.model.setPhysicalName(dim, t, name)
-        gmsh.model.mesh.generate(2)
-    soil_mesh = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
+    soil_mesh = rectangles({"soil": (0.0, -1.0, 4.0, 1.0, 16, 4)},
+                           {"soil_base": [("soil", "bottom")], "soil_top": [("soil", "top")]}, comm=comm)
     xb = np.linspace(0.5, 3.5, 13)
     beam_mesh = dc.io.mesh.from_arrays(np.column_stack([xb, np.zeros_like(xb)]),
                                        np.column_stack([np.arange(12), np.arange(1, 13)]), "beam",

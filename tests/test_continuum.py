@@ -6,34 +6,16 @@ from mpi4py import MPI
 
 import dolfinx_corot as dc
 from dolfinx_corot.assembly import make_system
+from dolfinx_corot.io.mesh import rectangles
 
 comm = MPI.COMM_WORLD
 L, H, E = 2.0, 1.0, 100.0
 
 
 def _rectangle(nx, ny, quads):
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-        p = [g.addPoint(x, y, 0.0) for x, y in ((0, 0), (L, 0), (L, H), (0, H))]
-        lines = [g.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
-        s = g.addPlaneSurface([g.addCurveLoop(lines)])
-        for line, n in zip(lines, (nx, ny, nx, ny)):
-            g.mesh.setTransfiniteCurve(line, n + 1)
-        g.mesh.setTransfiniteSurface(s)
-        if quads:
-            g.mesh.setRecombine(2, s)
-        g.synchronize()
-        for dim, tags, name in ((2, [s], "block"), (1, [lines[3]], "left"), (1, [lines[0]], "bottom"),
-                                (1, [lines[1]], "right"), (1, [lines[2]], "top")):
-            tag = gmsh.model.addPhysicalGroup(dim, tags)
-            gmsh.model.setPhysicalName(dim, tag, name)
-        gmsh.model.mesh.generate(2)
-    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
-    return tm
+    return rectangles({"block": (0.0, 0.0, L, H, nx, ny)},
+                      {"left": [("block", "left")], "bottom": [("block", "bottom")],
+                       "right": [("block", "right")], "top": [("block", "top")]}, comm=comm, quads=quads)
 
 
 def _box(n, hexes):

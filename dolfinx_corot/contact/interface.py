@@ -242,7 +242,6 @@ class Interface:
         self.candidates = np.zeros((0, 2), dtype=np.int64)
         self.anchor = None  # slave and master positions at the last search
         self.pairs_changed = True
-        self.K = None
         self.active = np.full(n, -1)
         self.frozen = False
         self._assigned = None

@@ -28,3 +28,13 @@ def reference(name: str) -> dict:
     path = os.path.join(here, "..", "reference", f"{name}.json")
     with open(path) as f:
         return json.load(f)
+
+
+def write_rows(path: str, rows: list) -> None:
+    """A CSV file of dict rows (the first row's keys as header); call on one rank."""
+    import csv
+
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)

@@ -339,3 +339,56 @@ def box(lengths, n, cell: str = "hexahedron", comm: MPI.Comm = MPI.COMM_WORLD) -
     order = np.argsort(facets)
     facet_tags = dolfinx.mesh.meshtags(mesh, 2, facets[order], values[order])
     return TaggedMesh(mesh, cell_tags, groups, facet_tags=facet_tags)
+
+
+def name_groups(groups: dict[str, tuple[int, list[int]]]) -> None:
+    """Physical groups of the current gmsh model: name → (dim, entity tags)."""
+    import gmsh
+
+    for name, (dim, tags) in groups.items():
+        tag = gmsh.model.addPhysicalGroup(dim, list(tags))
+        gmsh.model.setPhysicalName(dim, tag, name)
+
+
+SIDES = ("bottom", "right", "top", "left")
+
+
+def rectangles(blocks: dict[str, tuple], groups: dict[str, list[tuple[str, str]]] | None = None,
+               comm: MPI.Comm = MPI.COMM_WORLD, quads: bool = True) -> TaggedMesh:
+    """Structured quadrilateral blocks of one 2D mesh, not joined to each other: coincident edges
+    keep separate nodes (bodies that may come into contact).
+
+    blocks: name → (x0, y0, width, height, nx, ny); each block's cells form the group ``name``;
+    groups: edge groups, name → [(block, side), …] with side "bottom", "right", "top" or "left"
+    (a facet carries one tag: give each edge to one group at most); quads=False: triangles."""
+    import gmsh
+
+    taken = [m for members in (groups or {}).values() for m in members]
+    if len(set(taken)) != len(taken):
+        raise ValueError("rectangles: an edge is in two groups (a facet carries one tag)")
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        g = gmsh.model.geo
+        named, edges = {}, {}
+        for name, (x0, y0, w, h, nx, ny) in blocks.items():
+            pts = [g.addPoint(x, y, 0) for x, y in ((x0, y0), (x0 + w, y0), (x0 + w, y0 + h), (x0, y0 + h))]
+            lines = [g.addLine(pts[i], pts[(i + 1) % 4]) for i in range(4)]
+            surface = g.addPlaneSurface([g.addCurveLoop(lines)])
+            for line, n in zip(lines, (nx, ny, nx, ny)):
+                g.mesh.setTransfiniteCurve(line, n + 1)
+            g.mesh.setTransfiniteSurface(surface)
+            if quads:
+                g.mesh.setRecombine(2, surface)
+            named[name] = (2, [surface])
+            for side, line in zip(SIDES, lines):
+                edges[(name, side)] = line
+        for name, members in (groups or {}).items():
+            named[name] = (1, [edges[m] for m in members])
+        g.synchronize()
+        name_groups(named)
+        gmsh.model.mesh.generate(2)
+    tm = from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm

@@ -100,15 +100,13 @@ def boundary_surface(part, where: str) -> dict:
     c2v = mesh.topology.connectivity(tdim, 0)
     n_owned_cells = mesh.topology.index_map(tdim).size_local
     V = model.V
-    bs = V.dofmap.index_map_bs
-    imap = V.dofmap.index_map
-    n_owned_blocks = imap.size_local
     Xdof = V.tabulate_dof_coordinates()[:, :2]
-    seg_blocks, seg_owned = [], []
+    seg_blocks, inner = [], 0
     for f in facets:
         cells = f2c.links(f)
         if len(cells) != 1:
-            raise ContactError(f"contact surface '{where}': facet {f} is not on the boundary of the solid")
+            inner += 1
+            continue
         c = cells[0]
         if c >= n_owned_cells:
             continue  # the owner of the cell adds this facet
@@ -119,25 +117,12 @@ def boundary_surface(part, where: str) -> dict:
         t = Xdof[b] - Xdof[a]
         n = np.array([t[1], -t[0]])
         if np.dot(0.5 * (Xdof[a] + Xdof[b]) - centroid, n) < 0.0:
-            a, b = b, a
+            a, b = b, a  # the body on the left of a -> b
         seg_blocks.append((a, b))
-    seg_blocks = np.array(seg_blocks, dtype=np.int64).reshape(-1, 2)
-    # node keys: global block numbers of the model's function space
-    gblocks = imap.local_to_global(np.arange(imap.size_local + imap.num_ghosts, dtype=np.int32))
-    comm = model.comm
-    seg_keys = np.concatenate(comm.allgather(gblocks[seg_blocks].reshape(-1, 2))) if True else None
-    if len(seg_keys) == 0:
-        raise ContactError(f"contact surface '{where}' has no facets")
-    keys, segments = np.unique(seg_keys, return_inverse=True)
-    segments = segments.reshape(-1, 2)
-    X = np.zeros((len(keys), 2))
-    mine = np.isin(gblocks[:n_owned_blocks], keys)
-    own_blocks = np.flatnonzero(mine)
-    own_pos = np.searchsorted(keys, gblocks[own_blocks])
-    for pos, x in zip(comm.allgather(own_pos), comm.allgather(Xdof[own_blocks])):
-        X[pos] = x
-    ldofs = (own_blocks[:, None] * bs + np.arange(2)[None, :]).astype(np.int32)
-    return {"keys": keys, "X": X, "local": own_pos, "ldofs": ldofs, "segments": segments, "model": model}
+    if model.comm.allreduce(inner, op=MPI.SUM):  # raised on every rank
+        raise ContactError(f"contact surface '{where}': some of its lines lie inside the solid, "
+                           "not on its boundary")
+    return _gather_surface(model, np.array(seg_blocks, dtype=np.int64).reshape(-1, 2), Xdof, where)
 
 
 def _gather_surface(model, seg_blocks: np.ndarray, Xdof: np.ndarray, where: str) -> dict:

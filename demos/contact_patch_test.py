@@ -30,12 +30,21 @@
 #   interfaces then coincide, the exact (linear) fields are the discrete
 #   solution, and the test passes to round-off;
 # * two-pass with a plain penalty: the gaps stay at −p/ε, and the error is
-#   of the order of the penetration.
+#   of the order of the penetration;
+# * two-pass augmented Lagrangian on the smooth (C¹ Hermite) master curve,
+#   the library's default surface: its cubic shape functions share a
+#   slave's force among four master nodes, so even two coinciding
+#   interfaces do not transmit the consistent loads of a uniform pressure.
+#
+# The first three use the straight master segments (`smooth=False`), the
+# surface on which the patch test is defined.
 #
 # Measured: the deviation of the displacements from the best linear field
 # of each block, relative to the largest displacement — on 4/7 and 5/9
 # meshes: one-pass 1.7e-3 and 1.0e-3, two-pass augmented Lagrangian 2.4e-11
-# and 6.0e-12 (3 and 4 Uzawa updates), two-pass penalty 2.0e-3 and 1.4e-3.
+# and 6.0e-12 (3 and 4 Uzawa updates), two-pass penalty 2.0e-3 and 1.4e-3,
+# two-pass augmented Lagrangian on the smooth curve 3.2e-3 and 1.9e-3 (its
+# Uzawa updates stop at their limit: the gaps cannot all vanish).
 
 # %%
 import json
@@ -88,21 +97,24 @@ def linear_field_error(X, u):
 # ## Runs
 
 # %%
-methods = {
-    "one-pass, augmented Lagrangian": (False, dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4)),
-    "two-pass, augmented Lagrangian": (True, dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4)),
-    "two-pass, penalty": (True, dc.Penalty()),
+methods = {  # name: (symmetric, law, smooth master curve)
+    "one-pass, augmented Lagrangian": (False, dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4), False),
+    "two-pass, augmented Lagrangian": (True, dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4), False),
+    "two-pass, penalty": (True, dc.Penalty(), False),
+    "two-pass, augmented Lagrangian, smooth curve": (True, dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4),
+                                                     True),
 }
 rows = []
 for n_low, n_up in ((4, 7), (5, 9)):
-    for name, (symmetric, law) in methods.items():
+    for name, (symmetric, law, smooth) in methods.items():
         tm = two_blocks(n_low, n_up)
         sc = dc.Scene()
         b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
         sc.fix(b, "base", dofs=("uy",))
         sc.fix(b, "left", dofs=("ux",))
         sc.load(b, "top", traction=(0.0, -P))
-        sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), law=law, symmetric=symmetric)
+        sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), law=law, symmetric=symmetric,
+                   smooth=smooth)
         sc.monitor_reaction("base", b, "base")
         t0 = time.perf_counter()
         res = dc.solve(sc, dc.LoadControl(steps=1))
@@ -114,7 +126,7 @@ for n_low, n_up in ((4, 7), (5, 9)):
                "newton_iterations": int(res.history.column("iterations")[-1]),
                "uzawa_updates": int(res.history.column("uzawa_updates")[-1]), "wall_s": wall}
         rows.append(row)
-        say(f"{row['meshes']:5s} {name:32s}: deviation from homogeneity {err:.1e}; reaction {row['reaction']:.12f}; "
+        say(f"{row['meshes']:5s} {name:45s}: deviation from homogeneity {err:.1e}; reaction {row['reaction']:.12f}; "
             f"{row['newton_iterations']} Newton its, {row['uzawa_updates']} Uzawa updates")
 
 # %% [markdown]
@@ -130,7 +142,7 @@ if comm.rank == 0:
     write_rows(os.path.join(out, "patch_test.csv"), rows)
     fig, ax = plt.subplots(figsize=(7, 3.5))
     labels = [f"{r['meshes']}\n{r['method'].replace(', ', chr(10))}" for r in rows]
-    ax.bar(range(len(rows)), [max(r["error"], 1e-16) for r in rows], color=["C3", "C2", "C1"] * 2)
+    ax.bar(range(len(rows)), [max(r["error"], 1e-16) for r in rows], color=["C3", "C2", "C1", "C0"] * 2)
     ax.set_yscale("log")
     ax.set_xticks(range(len(rows)))
     ax.set_xticklabels(labels, fontsize=6)
@@ -153,4 +165,6 @@ for r in rows:
         assert r["error"] < 1e-8 and r["uzawa_updates"] <= 5, r   # passes (B5 criterion)
     if r["method"] == "one-pass, augmented Lagrangian":
         assert r["error"] > 1e-4, r                         # the known failure of one-pass NTS
+    if r["method"].endswith("smooth curve"):
+        assert 1e-4 < r["error"] < 1e-2, r                  # cubic force sharing: not exact
 say("contact_patch_test: verified")

@@ -267,19 +267,23 @@ class Scene:
         self._loads += 1
 
     def contact(self, slaves: tuple[PartRef, str], masters: tuple[PartRef, str], law=None,
-                symmetric: bool = False) -> list:
+                symmetric: bool = False, smooth: bool = True) -> list:
         """Node-to-segment contact (2D, frictionless) of the nodes of boundary group ``slaves[1]``
         of part ``slaves[0]`` against the boundary segments of ``masters``; ``symmetric`` adds
         the other direction (two-pass contact, for two deformable bodies).
 
         law: dc.Penalty() (default) or dc.AugmentedLagrangian(); the default penalty scales with
-        the bodies' stiffness and the master segments' length. Returns the interfaces made."""
+        the bodies' stiffness and the master segments' length.
+        smooth: the master surface is the C¹ Hermite curve through its nodes (normals continuous
+        from segment to segment: robust sliding over curved and deforming masters); False: the
+        straight segments (slave forces shared linearly by the segment's two nodes: the patch
+        test is passed exactly). Returns the interfaces made."""
         from .contact.interface import Interface, Penalty
 
         law = Penalty() if law is None else law
-        made = [Interface(slaves, masters, law)]
+        made = [Interface(slaves, masters, law, smooth)]
         if symmetric:
-            made.append(Interface(masters, slaves, law))
+            made.append(Interface(masters, slaves, law, smooth))
         self.interfaces += made
         return made
 
@@ -327,8 +331,9 @@ class Scene:
             out.append("prescribed displacements")
         for itf in self.interfaces:
             kind = "augmented Lagrangian" if itf.law.augmented else "penalty"
+            surface = "smooth master curve" if itf.smooth else "straight master segments"
             out.append(f"contact {itf.name}: {len(itf.area)} slave nodes on {len(itf.master['segments'])} "
-                       f"segments ({kind}, penalty {itf.penalty:.3g})")
+                       f"segments ({kind}, penalty {itf.penalty:.3g}, {surface})")
         return out
 
     def monitor_values(self, system) -> dict[str, float]:

@@ -37,7 +37,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from .kernels2d import node_to_segment, node_to_vertex
+from .kernels2d import node_to_smooth_segment, node_to_vertex, smooth_gap
 from .search import broad_phase, narrow_phase
 
 logger = logging.getLogger(__name__)
@@ -58,7 +58,7 @@ class AugmentedLagrangian(Penalty):
     """Penalty plus Uzawa updates of the contact pressure until the largest penetration is below
     ``gap_tolerance`` times the mean master segment length (at most ``max_updates`` per step)."""
 
-    gap_tolerance: float = 1e-4
+    gap_tolerance: float = 1e-3
     max_updates: int = 10
 
     augmented = True
@@ -168,14 +168,43 @@ def _tributary_lengths(X: np.ndarray, segments: np.ndarray) -> np.ndarray:
     return out
 
 
+def _smoothing_neighbours(X: np.ndarray, segments: np.ndarray, sharp: float) -> np.ndarray:
+    """(m, 4) nodes (p, a, b, q) of each master segment a → b: p the node before a and q the node
+    after b along the surface, whose positions set the averaged normals at a and b; p = a (q = b)
+    at a free end, where more than two segments meet, or where the surface turns by more than
+    ``sharp`` radians (the segment's own normal there)."""
+    nodes = len(X)
+    starts = np.bincount(segments[:, 0], minlength=nodes)
+    ends = np.bincount(segments[:, 1], minlength=nodes)
+    into = np.full(nodes, -1)   # the segment that ends at each node
+    out = np.full(nodes, -1)    # the segment that starts at it
+    into[segments[:, 1]] = np.arange(len(segments))
+    out[segments[:, 0]] = np.arange(len(segments))
+    manifold = (starts == 1) & (ends == 1)
+    t = X[segments[:, 1]] - X[segments[:, 0]]
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    a, b = segments[:, 0], segments[:, 1]
+    ext = np.column_stack([a, a, b, b])
+    prev = into[a]
+    ok = manifold[a] & (prev >= 0)
+    ok[ok] &= np.einsum("ij,ij->i", t[ok], t[prev[ok]]) >= np.cos(sharp)
+    ext[ok, 0] = segments[prev[ok], 0]
+    nxt = out[b]
+    ok = manifold[b] & (nxt >= 0)
+    ok[ok] &= np.einsum("ij,ij->i", t[ok], t[nxt[ok]]) >= np.cos(sharp)
+    ext[ok, 3] = segments[nxt[ok], 1]
+    return ext
+
+
 class Interface:
     """One direction of contact: the nodes of ``slaves`` against the segments of ``masters``
     (each a (part, boundary group name) pair). The symmetric (two-pass) contact of two
     deformable bodies is two interfaces, one each way."""
 
     XI_TOLERANCE = 0.05  # beyond a free end of the master surface: this far (× length) still on it
+    SMOOTH_ANGLE = np.radians(60.0)  # master vertices where the surface turns more than this stay sharp
 
-    def __init__(self, slaves, masters, law: Penalty):
+    def __init__(self, slaves, masters, law: Penalty, smooth: bool = True):
         if not isinstance(law, Penalty):
             raise TypeError(f"contact law must be dc.Penalty or dc.AugmentedLagrangian, got {type(law).__name__}")
         self.slave_spec, self.master_spec, self.law = slaves, masters, law
@@ -203,6 +232,10 @@ class Interface:
                 moduli.append(m.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN))
             self.penalty = law.factor * min(moduli) / self.h
         self.valence = np.bincount(sm.ravel(), minlength=len(Xm))  # segments at each master node
+        # nodes (p, a, b, q) of each segment's curve; p = a, q = b: the straight segment
+        self.smooth = bool(smooth)
+        self.ext = (_smoothing_neighbours(Xm, sm, self.SMOOTH_ANGLE) if smooth
+                    else np.column_stack([sm[:, 0], sm[:, 0], sm[:, 1], sm[:, 1]]))
         self.multiplier = np.zeros(len(self.area))
         self.margin = 0.5 * self.h
         self.touch = 1e-6 * self.h  # a gap below this keeps the penalty stiffness (no force)
@@ -256,7 +289,7 @@ class Interface:
     def evaluate(self):
         """Forces and tangents of this rank's slaves at the current configuration.
 
-        Returns (dofs (k, 6) global, f (k, 6), K (k, 6, 6), (slave, segment) (k,)) over the
+        Returns (dofs (k, 10) global, f (k, 10), K (k, 10, 10), (slave, segment) (k,)) over the
         pairs in contact (p > 0)."""
         xs, xm = self._positions(self.slave), self._positions(self.master)
         self._search(xs, xm)
@@ -265,59 +298,88 @@ class Interface:
         self.active[:] = -1
         if len(mine_pairs) == 0:
             self._last = (np.zeros(0, dtype=np.int64), np.zeros(0))
-            self._forces = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 6)))
-            return (np.zeros((0, 6), dtype=np.int64), np.zeros((0, 6)), np.zeros((0, 6, 6)),
+            self._forces = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 10)))
+            return (np.zeros((0, 10), dtype=np.int64), np.zeros((0, 10)), np.zeros((0, 10, 10)),
                     (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)))
-        # narrow phase over this rank's candidates: closest segment per slave, and where on it:
-        # inside (node-to-segment), or at one of its ends (node-to-vertex when a second segment
-        # shares that vertex; at a free end of the surface the segment's line, up to a small
-        # tolerance). Once frozen (late Newton iterations) a slave keeps its assignment: one at
-        # a vertex where the normal turns would otherwise alternate without converging.
+        # narrow phase over this rank's candidates on the smooth surface: each slave takes the
+        # segment on which its closest point falls inside [0, 1] (a little beyond a free end of
+        # the surface) with the smallest |g|. A slave outside a sharp
+        # convex corner has none: it meets the corner's vertex (node-to-vertex). Once frozen
+        # (late Newton iterations) a slave keeps its assignment.
         if not (self.frozen and self._assigned is not None):
-            segment, xi = narrow_phase(xs, xm[seg[:, 0]], xm[seg[:, 1]], mine_pairs)
-            mode = np.zeros(len(segment), dtype=np.int64)             # 0: on the segment
-            end = np.where(xi < 0.0, 0, 1)
-            beyond = (segment >= 0) & ((xi < 0.0) | (xi > 1.0))
-            vertex = np.where(beyond, seg[np.maximum(segment, 0), end], -1)
-            shared = beyond & (self.valence[np.maximum(vertex, 0)] >= 2)
-            mode[shared] = 1 + end[shared]                           # 1, 2: at vertex a, b
-            free_end = beyond & ~shared & ((xi < -self.XI_TOLERANCE) | (xi > 1.0 + self.XI_TOLERANCE))
-            segment = np.where(free_end, -1, segment)
-            self._assigned = (segment, mode)
+            self._assigned = self._assign(xs, xm, mine_pairs)
         segment, mode = self._assigned
         s = self.mine[segment[self.mine] >= 0]
         m = segment[s]
         self.active[:] = -1
         self.active[s] = m
         n = len(s)
+        ext = self.ext[m]
         g = np.zeros(n)
-        f = np.zeros((n, 6))
-        K = np.zeros((n, 6, 6))
+        f = np.zeros((n, 10))
+        K = np.zeros((n, 10, 10))
         lam, eps = self.multiplier[s], np.full(n, self.penalty)
         on = mode[s] == 0
         if on.any():
             i = np.flatnonzero(on)
-            g[i], _, _, f[i], K[i], _ = node_to_segment(xs[s[i]], xm[seg[m[i], 0]], xm[seg[m[i], 1]], lam[i],
-                                                       eps[i], self.area[s[i]], True, self.touch)
+            x = np.hstack([xs[s[i]], xm[ext[i, 0]], xm[ext[i, 1]], xm[ext[i, 2]], xm[ext[i, 3]]])
+            g[i], _, _, f[i], K[i], _ = node_to_smooth_segment(x, lam[i], eps[i], self.area[s[i]], True,
+                                                               self.touch)
         if (~on).any():
             normals = self._vertex_normals(xm)
             for k in (1, 2):
                 i = np.flatnonzero(mode[s] == k)
                 if not len(i):
                     continue
-                v = seg[m[i], k - 1]
+                v = ext[i, k]
                 gv, _, fv, Kv = node_to_vertex(xs[s[i]], xm[v], normals[v], lam[i], eps[i], self.area[s[i]],
                                                True, self.touch)
-                idx = np.array([0, 1, 2, 3]) if k == 1 else np.array([0, 1, 4, 5])
+                idx = np.array([0, 1, 2 * k + 2, 2 * k + 3])
                 g[i] = gv
                 f[np.ix_(i, idx)] = fv
                 K[np.ix_(i, idx, idx)] = Kv
         keep = (lam - self.penalty * g) >= -self.penalty * self.touch  # closed or touching
-        dofs = np.hstack([self.slave["gdofs"][s], self.master["gdofs"][seg[m, 0]],
-                          self.master["gdofs"][seg[m, 1]]])
+        gd = self.master["gdofs"]
+        dofs = np.hstack([self.slave["gdofs"][s]] + [gd[ext[:, j]] for j in range(4)])
         self._last = (s, g)
         self._forces = (s[keep], m[keep], f[keep])
         return dofs[keep], f[keep], K[keep], (s[keep], m[keep])
+
+    def _assign(self, xs, xm, pairs):
+        """(segment (n_slaves,), mode (n_slaves,)) of this rank's candidate pairs: mode 0 on the
+        segment, 1 / 2 at its vertex a / b (a sharp corner); segment −1: no contact partner."""
+        n = len(self.area)
+        ext = self.ext[pairs[:, 1]]
+        x = np.hstack([xs[pairs[:, 0]]] + [xm[ext[:, j]] for j in range(4)])
+        g, xi, ok = smooth_gap(x)
+        lo = np.where(self.valence[ext[:, 1]] >= 2, -1e-9, -self.XI_TOLERANCE)
+        hi = np.where(self.valence[ext[:, 2]] >= 2, 1.0 + 1e-9, 1.0 + self.XI_TOLERANCE)
+        # a pair counts within the search margin outside and one mean segment length inside: the
+        # candidates of a wild Newton iterate stay in the list, and the far side of a body is no
+        # partner
+        valid = ok & (xi >= lo) & (xi <= hi) & (g > -self.h) & (g < self.margin)
+        segment = np.full(n, -1)
+        mode = np.zeros(n, dtype=np.int64)
+        if valid.any():
+            v = np.flatnonzero(valid)
+            order = np.lexsort((pairs[v, 1], np.abs(g[v]), pairs[v, 0]))  # by slave, |g|, segment
+            first = v[order][np.r_[True, np.diff(pairs[v[order], 0]) != 0]]
+            segment[pairs[first, 0]] = pairs[first, 1]
+        # slaves without a projection: the closest point of the straight surface, if it is a sharp
+        # vertex shared by two segments (outside a convex corner) within the search margin
+        rest = pairs[segment[pairs[:, 0]] < 0]
+        if len(rest):
+            seg = self.master["segments"]
+            near, t = narrow_phase(xs, xm[seg[:, 0]], xm[seg[:, 1]], rest)
+            end = np.where(t < 0.0, 0, 1)
+            m = np.maximum(near, 0)
+            vertex = seg[m, end]
+            sharp = np.where(end == 0, self.ext[m, 0] == self.ext[m, 1], self.ext[m, 3] == self.ext[m, 2])
+            close = np.linalg.norm(xs - xm[vertex], axis=1) < self.margin
+            corner = (near >= 0) & ((t < 0.0) | (t > 1.0)) & (self.valence[vertex] >= 2) & sharp & close
+            segment[corner] = near[corner]
+            mode[corner] = 1 + end[corner]
+        return segment, mode
 
     def _vertex_normals(self, xm: np.ndarray) -> np.ndarray:
         """Unit averaged outward normals (n_master, 2) of the master nodes (current)."""
@@ -343,6 +405,8 @@ class Interface:
         # in contact (p > 0) the gap should vanish: penetration, or an opening the pressure holds
         closed = self.multiplier[s] - self.penalty * g > 0.0
         error = self.comm.allreduce(float(np.max(np.abs(g[closed]), initial=0.0)), op=MPI.MAX)
+        logger.debug("contact %s: largest |g| of closed pairs %.3e (tolerance %.3e), %d updates", self.name, error,
+                     self.law.gap_tolerance * self.h, self.uzawa_updates)
         if error <= self.law.gap_tolerance * self.h or self.uzawa_updates >= self.law.max_updates:
             return False
         new = np.zeros_like(self.multiplier)
@@ -374,8 +438,8 @@ class Interface:
         s, m, f = self._forces
         seg = self.master["segments"]
         force = np.zeros((len(self.master["X"]), 2))
-        np.add.at(force, seg[m, 0], f[:, 2:4])
-        np.add.at(force, seg[m, 1], f[:, 4:6])
+        for j in range(4):
+            np.add.at(force, self.ext[m, j], f[:, 2 * j + 2:2 * j + 4])
         total = np.zeros_like(force)
         self.comm.Allreduce(force, total, op=MPI.SUM)
         length = _tributary_lengths(self.master["X"], seg)
@@ -383,11 +447,17 @@ class Interface:
         return x, np.linalg.norm(total, axis=1) / length
 
 
+def _positive_part(K: np.ndarray) -> np.ndarray:
+    """The pair tangents (k, n, n) with their negative eigenvalues set to zero."""
+    lam, vec = np.linalg.eigh(K)
+    return np.einsum("kij,kj,klj->kil", vec, np.maximum(lam, 0.0), vec)
+
+
 class ContactSet:
     """The interfaces of a scene bound to one system: adds their forces to f_int and their
     tangent to the system matrix through a matrix over the candidate pairs."""
 
-    FREEZE_AFTER = 6
+    FREEZE_AFTER = 10**9
 
     def __init__(self, interfaces, system):
         self.interfaces = list(interfaces)
@@ -399,6 +469,10 @@ class ContactSet:
         self._blocks = []
         self.pattern_builds = 0
         self.time = 0.0  # s spent in contact search, kernels and assembly
+        # Newton sets this after an iteration that raised the residual: the next tangent keeps only
+        # the positive part of each pair's tangent (the curvature terms of a slave pressed on a
+        # convex master can make an intermediate iterate's tangent indefinite)
+        self.project = False
 
     def begin_newton(self) -> None:
         """A Newton solve starts: slaves may choose their master segments again."""
@@ -422,21 +496,21 @@ class ContactSet:
         self.time += time.perf_counter() - t
 
     def _pair_dofs(self, itf, slaves, segments) -> np.ndarray:
-        """Global dofs (k, 6) of slave–segment pairs, −1 on constrained dofs (PETSc skips them)."""
-        seg = itf.master["segments"]
-        dofs = np.hstack([itf.slave["gdofs"][slaves], itf.master["gdofs"][seg[segments, 0]],
-                          itf.master["gdofs"][seg[segments, 1]]])
+        """Global dofs (k, 10) of slave–segment pairs (slave, p, a, b, q), −1 on constrained dofs
+        (PETSc skips them)."""
+        ext, gd = itf.ext[segments], itf.master["gdofs"]
+        dofs = np.hstack([itf.slave["gdofs"][slaves]] + [gd[ext[:, j]] for j in range(4)])
         dofs[np.isin(dofs, itf.constrained)] = -1
         return dofs
 
     def _build_pattern(self, A: PETSc.Mat) -> None:
-        """C's pattern: the 6 × 6 blocks of every candidate pair of every rank, row by row."""
+        """C's pattern: the 10 × 10 blocks of every candidate pair of every rank, row by row."""
         rows, cols = [], []
         for itf in self.interfaces:
             c = itf.candidates
             dofs = self._pair_dofs(itf, c[:, 0], c[:, 1])
-            rows.append(np.repeat(dofs, 6, axis=1).ravel())
-            cols.append(np.tile(dofs, (1, 6)).ravel())
+            rows.append(np.repeat(dofs, 10, axis=1).ravel())
+            cols.append(np.tile(dofs, (1, 10)).ravel())
         r, q = np.concatenate(rows), np.concatenate(cols)
         keep = (r >= 0) & (q >= 0)
         entries = np.unique(np.stack([r[keep], q[keep]], axis=1), axis=0)
@@ -474,6 +548,8 @@ class ContactSet:
         for itf, (dofs, K, (s, m)) in zip(self.interfaces, self._blocks):
             if len(s):
                 d = self._pair_dofs(itf, s, m).astype(PETSc.IntType)
+                if self.project:
+                    K = _positive_part(K)
                 self.C.setValuesRCV(d, d, K, addv=PETSc.InsertMode.ADD_VALUES)
         self.C.assemble()
         lgmap = A.getLGMap()
@@ -481,6 +557,25 @@ class ContactSet:
         if not self._merged:
             A.setLGMap(*lgmap)  # a new pattern replaces the matrix's internals
             self._merged = True
+
+    def step_scale(self, dx: PETSc.Vec) -> float:
+        """A factor ≤ 1 for the Newton correction ``dx`` that keeps every contact node's motion
+        within its interface's search margin (half a master segment): a correction that would
+        carry a node several segments along a surface comes from a tangent linearized far from
+        there (e.g. indefinite at an intermediate iterate) and is shortened; the next
+        iterations continue from the shorter step."""
+        start, stop = dx.getOwnershipRange()
+        values = dx.getArray(readonly=True)
+        worst = 0.0
+        for itf in self.interfaces:
+            for surf in (itf.slave, itf.master):
+                gd = surf["gdofs"]
+                own = ((gd >= start) & (gd < stop)).all(axis=1)
+                if own.any():
+                    d = values[gd[own] - start]
+                    worst = max(worst, float(np.sqrt((d * d).sum(axis=1)).max()) / itf.margin)
+        worst = self.comm.allreduce(worst, op=MPI.MAX)
+        return 1.0 if worst <= 1.0 else 1.0 / worst
 
     def augment(self) -> bool:
         """One Uzawa update on every augmented interface that needs it; True if any changed."""

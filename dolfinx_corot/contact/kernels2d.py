@@ -190,3 +190,183 @@ def node_to_vertex(xs, xv, normal, multiplier, penalty, area, with_tangent, touc
                 K[i, r, q + 2] += h
                 K[i, r + 2, q] += h
     return g, p, f, K
+
+
+# -- smooth (C¹) master surface ---------------------------------------------------------------
+@numba.njit(cache=True, error_model="numpy")
+def _hermite(x, xi):
+    """Point, first and second derivatives of the Hermite curve of the segment a → b at ξ, and the
+    weights φ of (p, a, b, q); x = (x_s, x_p, x_a, x_b, x_q) flattened (10,).
+
+    Nodal tangents: Catmull–Rom, (x_b − x_p)/2 at a and (x_q − x_a)/2 at b; at an end without a
+    neighbour (p = a or q = b: a free end or a sharp corner) the natural end condition x'' = 0,
+    which keeps an evenly divided straight surface exactly straight and linearly parametrized."""
+    free_a = x[2].real == x[4].real and x[3].real == x[5].real
+    free_b = x[8].real == x[6].real and x[9].real == x[7].real
+    # tangents as combinations of (p, a, b, q)
+    if free_a and free_b:
+        ca = (0.0, -1.0, 1.0, 0.0)
+        cb = (0.0, -1.0, 1.0, 0.0)
+    elif free_a:
+        ca = (0.0, -1.25, 1.5, -0.25)
+        cb = (0.0, -0.5, 0.0, 0.5)
+    elif free_b:
+        ca = (-0.5, 0.0, 0.5, 0.0)
+        cb = (0.25, -1.5, 1.25, 0.0)
+    else:
+        ca = (-0.5, 0.0, 0.5, 0.0)
+        cb = (0.0, -0.5, 0.0, 0.5)
+    x2 = xi * xi
+    x3 = x2 * xi
+    h00, h10, h01, h11 = 2 * x3 - 3 * x2 + 1, x3 - 2 * x2 + xi, -2 * x3 + 3 * x2, x3 - x2
+    d00, d10, d01, d11 = 6 * x2 - 6 * xi, 3 * x2 - 4 * xi + 1, -6 * x2 + 6 * xi, 3 * x2 - 2 * xi
+    s00, s10, s01, s11 = 12 * xi - 6, 6 * xi - 4, -12 * xi + 6, 6 * xi - 2
+    w = (h10 * ca[0] + h11 * cb[0], h00 + h10 * ca[1] + h11 * cb[1],
+         h01 + h10 * ca[2] + h11 * cb[2], h10 * ca[3] + h11 * cb[3])
+    dw = (d10 * ca[0] + d11 * cb[0], d00 + d10 * ca[1] + d11 * cb[1],
+          d01 + d10 * ca[2] + d11 * cb[2], d10 * ca[3] + d11 * cb[3])
+    sw = (s10 * ca[0] + s11 * cb[0], s00 + s10 * ca[1] + s11 * cb[1],
+          s01 + s10 * ca[2] + s11 * cb[2], s10 * ca[3] + s11 * cb[3])
+    px = w[0] * x[2] + w[1] * x[4] + w[2] * x[6] + w[3] * x[8]
+    py = w[0] * x[3] + w[1] * x[5] + w[2] * x[7] + w[3] * x[9]
+    tx = dw[0] * x[2] + dw[1] * x[4] + dw[2] * x[6] + dw[3] * x[8]
+    ty = dw[0] * x[3] + dw[1] * x[5] + dw[2] * x[7] + dw[3] * x[9]
+    cx = sw[0] * x[2] + sw[1] * x[4] + sw[2] * x[6] + sw[3] * x[8]
+    cy = sw[0] * x[3] + sw[1] * x[5] + sw[2] * x[7] + sw[3] * x[9]
+    return px, py, tx, ty, cx, cy, w
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _closest_on_curve(x, xi, iterations):
+    """Newton on (x_s − x(ξ))·x'(ξ) = 0 from ξ; returns (ξ, converged to a distance minimum).
+    Quadratic convergence: one more iteration after a correction below 1e-9 reaches round-off."""
+    if not abs(xi.real) < 3.0:
+        return xi, False
+    last = False
+    for _ in range(iterations):
+        px, py, tx, ty, cx, cy, w = _hermite(x, xi)
+        rx = x[0] - px
+        ry = x[1] - py
+        f = rx * tx + ry * ty
+        df = -(tx * tx + ty * ty) + rx * cx + ry * cy
+        if not df.real < 0.0:
+            return xi, False  # not a distance minimum (a slave beyond the curvature centre)
+        step = f / df
+        xi = xi - step
+        if last:
+            # beyond its ends a segment's cubic may turn back: its points there are not used
+            return xi, -0.25 < xi.real < 1.25
+        last = abs(step.real) < 1e-9
+        if not abs(xi.real) < 3.0:
+            return xi, False  # far beyond the segment: another segment's point
+    return xi, False
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _smooth_gap_gradient(x, out, xi):
+    r"""Gap to the C¹ master curve through x = (x_s, x_p, x_a, x_b, x_q) flattened (10,), real or
+    complex, from the projection coordinate ξ solved to round-off (the real part); returns (g, ξ)
+    and N = ∂g/∂x in ``out``: (n, −φ_p n, −φ_a n, −φ_b n, −φ_q n) — at the closest point the
+    variations of ξ and of the normal drop out (r ∥ n ⊥ x')."""
+    px, py, tx, ty, cx, cy, w = _hermite(x, xi)
+    lt = np.sqrt(tx * tx + ty * ty)
+    nx = ty / lt
+    ny = -tx / lt
+    g = (x[0] - px) * nx + (x[1] - py) * ny
+    out[0] = nx
+    out[1] = ny
+    for k in range(4):
+        out[2 + 2 * k] = -w[k] * nx
+        out[3 + 2 * k] = -w[k] * ny
+    return g
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _straight_xi(x):
+    dx = x[6] - x[4]
+    dy = x[7] - x[5]
+    return ((x[0] - x[4]) * dx + (x[1] - x[5]) * dy) / (dx * dx + dy * dy)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def smooth_gap(x):
+    """Gap, projection coordinate and validity (a distance minimum was found) of k slave–segment
+    pairs on the C¹ master curve; x: (k, 10) positions of (slave, p, a, b, q)
+    (see :func:`node_to_smooth_segment`)."""
+    k = x.shape[0]
+    g = np.empty(k)
+    xi = np.empty(k)
+    ok = np.empty(k, dtype=np.bool_)
+    N = np.empty(10)
+    for i in range(k):
+        xii, oki = _closest_on_curve(x[i], _straight_xi(x[i]), 30)
+        g[i] = _smooth_gap_gradient(x[i], N, xii) if oki else np.inf
+        xi[i] = xii
+        ok[i] = oki
+    return g, xi, ok
+
+
+@numba.njit(cache=True, error_model="numpy")
+def node_to_smooth_segment(x, multiplier, penalty, area, with_tangent, touch=0.0):
+    r"""Contact force and tangent of k slaves on the segments of a C¹ master curve.
+
+    Each master segment a → b is replaced by the cubic Hermite curve through x_a and x_b with the
+    nodal tangents (x_b − x_p)/2 and (x_q − x_a)/2 (Catmull–Rom; p and q the neighbouring nodes on
+    the surface; p = a or q = b at a sharp corner or a free end, where the curve ends with zero
+    curvature): neighbouring segments share the tangent at their common node, so the surface, its normal and the gap are continuous
+    with their first derivatives when a slave passes from one segment to the next (the straight
+    segments turn their normal abruptly there; Wriggers 2006, §9.4; Padmanabhan & Laursen 2001).
+    A straight, evenly divided surface stays the straight segments. The closest point x(ξ)
+    solves (x_s − x(ξ))·x'(ξ) = 0 (Newton), g = (x_s − x(ξ))·n with n ⊥ x'.
+
+    x: (k, 10) current positions (x_s, x_p, x_a, x_b, x_q); multiplier, penalty, area: (k,).
+    Returns g, ξ, p: (k,); f: (k, 10); K: (k, 10, 10); energy (k,). Pressure law, force and
+    tangent as :func:`node_to_segment` (f = −A p N, K = A(ε N Nᵀ − p ∂²g), ∂²g by complex step
+    of N, the projection re-solved in complex arithmetic)."""
+    k = x.shape[0]
+    g = np.empty(k)
+    xi = np.empty(k)
+    p = np.zeros(k)
+    energy = np.zeros(k)
+    f = np.zeros((k, 10))
+    K = np.zeros((k, 10, 10))
+    N = np.empty(10)
+    xc = np.empty(10, dtype=np.complex128)
+    Nc = np.empty(10, dtype=np.complex128)
+    for i in range(k):
+        xii, ok = _closest_on_curve(x[i], _straight_xi(x[i]), 30)
+        xi[i] = xii
+        if not ok:
+            g[i] = np.inf
+            continue
+        gi = _smooth_gap_gradient(x[i], N, xii)
+        g[i] = gi
+        eps = penalty[i]
+        pi = multiplier[i] - eps * gi
+        if pi < -eps * touch:
+            continue
+        pi = max(pi, 0.0)
+        p[i] = pi
+        a = area[i]
+        energy[i] = 0.5 * a * pi * pi / eps
+        for r in range(10):
+            f[i, r] = -a * pi * N[r]
+        if not with_tangent:
+            continue
+        for r in range(10):
+            for c in range(10):
+                K[i, r, c] = a * eps * N[r] * N[c]
+        for c in range(10):
+            for j in range(10):
+                xc[j] = x[i, j]
+            xc[c] += 1j * _H
+            xic, _ = _closest_on_curve(xc, xii + 0j, 3)
+            _smooth_gap_gradient(xc, Nc, xic)
+            for r in range(10):
+                K[i, r, c] -= a * pi * Nc[r].imag / _H
+        for r in range(10):
+            for c in range(r + 1, 10):
+                s = 0.5 * (K[i, r, c] + K[i, c, r])
+                K[i, r, c] = s
+                K[i, c, r] = s
+    return g, xi, p, f, K, energy

@@ -40,7 +40,9 @@ class NewtonOptions:
     the step's increment; max_iterations per attempt;
     divergence_factor: ‖r‖ above this multiple of max(initial ‖r‖, reference force) is divergence;
     line_search: scale the correction so that the energy is nearly stationary along it
-    (at most ``line_search_trials`` extra residual evaluations per iteration);
+    (at most ``line_search_trials`` extra residual evaluations per iteration; a correction that
+    inverts an element is halved until the residual is finite); None (default): on for scenes with
+    contact, whose active set and closest points change within a step, off otherwise;
     forcing: inexact Newton for iterative linear solvers (Eisenstat & Walker 1996, choice 2):
     the first solve of a step to ``forcing_initial``, then to
     η_k = γ (‖r_k‖/‖r_{k−1}‖)², kept below ``forcing_max`` and not below what the
@@ -54,7 +56,7 @@ class NewtonOptions:
     xtol: float = 1e-10
     max_iterations: int = 25
     divergence_factor: float = 1e10
-    line_search: bool = False
+    line_search: bool | None = None
     line_search_trials: int = 4
     line_search_tolerance: float = 0.5
     max_growth: int = 3
@@ -95,11 +97,14 @@ def converged(norm: float, ref: float, report: NewtonReport, system, options: Ne
 def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions()) -> NewtonReport:
     """Iterate to equilibrium at ``load_factor``; returns a report (does not raise on divergence)."""
     report = NewtonReport(False, 0)
+    line_search = options.line_search
+    if line_search is None:
+        line_search = getattr(system, "contact", None) is not None
+    system.begin_step()  # before the first residual: contact chooses its pairs afresh
     norm, ref = system.residual(load_factor)
     report.residuals.append(norm)
     scale = max(norm, ref)
     growth = 0
-    system.begin_step()
     small_correction = False
     for it in range(1, options.max_iterations + 1):
         tol = options.rtol * ref + options.atol
@@ -112,13 +117,21 @@ def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions())
                 eta = forcing_term(options, norm, report.residuals[-2] if it > 1 else None,
                                    eta if it > 1 else None, tol)
                 system.set_forcing(eta)
+        contact = getattr(system, "contact", None)
+        if contact is not None:
+            # after a rise of the residual, the positive part of the contact tangents
+            contact.project = it > 1 and report.residuals[-1] > report.residuals[-2]
         system.jacobian()
         try:
             report.increments.append(system.solve())
         except np.linalg.LinAlgError as err:
             report.reason = str(err)
             break
-        if options.line_search:
+        if contact is not None:
+            scale = contact.step_scale(system.dx)  # contact nodes move at most a search margin
+            if scale < 1.0:
+                system.dx.scale(scale)
+        if line_search:
             norm, ref = _line_search(system, load_factor, options.line_search_trials,
                                      options.line_search_tolerance)
         else:
@@ -168,13 +181,18 @@ def _line_search(system, load_factor: float, trials: int, tolerance: float) -> t
     """Apply s·dx with s from a secant search on g(s) = dx·r; returns the new (‖r‖, ref)."""
     g0 = system.directional_residual()
     base = system.checkpoint()
-    system.update(1.0)
+    s = 1.0
+    system.update(s)
     norm, ref = system.residual(load_factor)
-    if not (g0 > 0.0):
+    while not math.isfinite(norm) and s > 1.0 / 64:
+        s *= 0.5  # the full correction inverts an element: back off
+        system.restore(base)
+        system.update(s)
+        norm, ref = system.residual(load_factor)
+    if not (g0 > 0.0) or s < 1.0:
         return norm, ref
     g = system.directional_residual()
     best = (abs(g), 1.0, norm, ref)
-    s = 1.0
     for _ in range(trials):
         if abs(g) <= tolerance * g0 or not math.isfinite(g):
             break

@@ -94,10 +94,12 @@ def test_contact_errors_name_the_culprit():
 
 
 @pytest.mark.skipif(comm.size > 1, reason="dense FD check of the assembled system: serial")
+@pytest.mark.parametrize("smooth", [True, False], ids=["smooth", "straight"])
 @pytest.mark.parametrize("symmetric", [False, True])
-def test_assembled_contact_tangent_matches_finite_differences(symmetric):
+def test_assembled_contact_tangent_matches_finite_differences(symmetric, smooth):
     """The system's tangent (bodies + contact, constrained rows included) against central
-    differences of its residual at a penetrating, sheared state of the two blocks."""
+    differences of its residual at a penetrating, sheared, randomly perturbed state of the two
+    blocks (smooth master curves: the neighbouring master nodes enter each pair)."""
     from dolfinx_corot.assembly import make_system
 
     tm = _two_blocks(3, 4)
@@ -107,7 +109,7 @@ def test_assembled_contact_tangent_matches_finite_differences(symmetric):
     sc.fix(b, "left", dofs=("ux",))
     sc.load(b, "top", traction=(0.0, -P))
     sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"),
-               law=dc.AugmentedLagrangian(), symmetric=symmetric)
+               law=dc.AugmentedLagrangian(), symmetric=symmetric, smooth=smooth)
     for itf in sc.interfaces:
         itf.multiplier[:] = 0.3 * P  # an augmented state
     system = make_system(sc.model, contacts=sc.interfaces)
@@ -214,6 +216,41 @@ def test_swapping_the_bodies_of_symmetric_contact_changes_nothing():
         runs.append(sc.model.nodes()[1])
     if comm.rank == 0:
         assert np.abs(runs[0] - runs[1]).max() < 1e-10 * np.abs(runs[0]).max()
+
+
+def test_stale_candidates_are_no_partners():
+    """Candidate pairs left from a far-off configuration (e.g. a diverged Newton iterate) do not
+    act: a slave whose only candidates are on the far side of the master body (a valid closest
+    point, gap −1.1) gets no force, and the real partners act as from a fresh search."""
+    from dolfinx_corot.assembly import make_system
+
+    tm = rectangles({"lower": (0.0, 0.0, 1.0, 1.0, 4, 2), "upper": (0.0, 1.1, 1.0, 1.0, 3, 2)},
+                    {"lower_faces": [("lower", "top"), ("lower", "bottom")], "upper_bottom": [("upper", "bottom")]},
+                    comm=comm)
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+    (itf,) = sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_faces"))
+    system = make_system(sc.model, contacts=sc.interfaces)
+    xs, xm = itf._positions(itf.slave), itf._positions(itf.master)
+    seg = itf.master["segments"]
+    bottom = np.flatnonzero(xm[seg].mean(axis=1)[:, 1] < 0.5)
+    assert len(bottom) == 4
+    itf.anchor = (xs.copy(), xm.copy())  # no new search
+    itf.candidates = np.array([(s, m) for s in itf.mine for m in bottom], dtype=np.int64).reshape(-1, 2)
+    dofs, f, K, pairs = itf.evaluate()
+    assert len(pairs[0]) == 0 and np.all(itf.active == -1)
+    # pressed 0.01 into the top: the same forces with or without the stale bottom candidates
+    u = sc.model.state.x.array.reshape(-1, 2)
+    X = sc.model.V.tabulate_dof_coordinates()
+    u[:, 1] = np.where(X[:, 1] > 1.05, -0.11, 0.0)
+    itf.anchor = None
+    fresh = itf.evaluate()
+    itf.candidates = np.unique(np.vstack([itf.candidates, [(s, m) for s in itf.mine for m in bottom]]), axis=0)
+    itf.anchor = (itf._positions(itf.slave), itf._positions(itf.master))
+    stale = itf.evaluate()
+    assert comm.allreduce(len(fresh[3][0]), op=MPI.SUM) == 4
+    assert np.array_equal(fresh[0], stale[0]) and np.allclose(fresh[1], stale[1], rtol=0, atol=1e-15)
+    system.destroy()
 
 
 def test_an_idle_interface_changes_nothing_and_builds_no_matrix():

@@ -127,3 +127,99 @@ def test_node_to_vertex_continues_node_to_segment_at_the_segment_end():
     gv, pv, fv, Kv = node_to_vertex(xs[None], x2[None], np.array([[0.0, -1.0]]), lam, eps, area, True)
     assert abs(gv[0] - g[0]) < 1e-15 and abs(pv[0] - p[0]) < 1e-12
     assert np.abs(fv[0] - f[0][[0, 1, 4, 5]]).max() < 1e-12
+
+
+# -- smooth (C¹ Hermite) master curve ---------------------------------------------------------
+def _arc_nodes(rng, n=6, radius=2.0, spacing=0.35):
+    """Nodes of a convex arc (body below, traversed in −x so that it lies on the left), jittered."""
+    th = (np.arange(n) - (n - 1) / 2) * spacing / radius * rng.uniform(0.8, 1.2, n)
+    pts = np.column_stack([radius * np.sin(th), radius * np.cos(th) - radius])[::-1]
+    return pts + rng.normal(0.0, 0.01, pts.shape)
+
+
+def _pair_x(nodes, j, xs, free_a=False, free_b=False):
+    """(x_s, x_p, x_a, x_b, x_q) of segment j → j+1 of a chain of nodes."""
+    p = j if free_a else j - 1
+    q = j + 1 if free_b else j + 2
+    return np.concatenate([xs, nodes[p], nodes[j], nodes[j + 1], nodes[q]])
+
+
+@pytest.mark.parametrize("ends", ["inside", "free a", "free b", "free both"])
+def test_smooth_kernel_force_and_tangent_match_finite_differences(ends):
+    """f = ∂Φ/∂x and K = ∂f/∂x of the smooth-curve kernel by central differences at random
+    penetrating slaves on a jittered arc (penalty and augmented Lagrangian). At a free end
+    p = a (or q = b) is one node: the derivatives are those of the node's summed columns."""
+    from dolfinx_corot.contact.kernels2d import node_to_smooth_segment, smooth_gap
+
+    rng = np.random.default_rng(11)
+    free_a, free_b = ends in ("free a", "free both"), ends in ("free b", "free both")
+    for trial in range(8):
+        nodes = _arc_nodes(rng)
+        a, b = nodes[2], nodes[3]
+        t = (b - a) / np.linalg.norm(b - a)
+        xs = a + rng.uniform(0.1, 0.9) * (b - a) + rng.uniform(0.01, 0.05) * np.array([-t[1], t[0]])
+        x0 = _pair_x(nodes, 2, xs, free_a, free_b)
+        # independent coordinates: slave, (p), a, b, (q); P maps them to the 10 entries
+        slots = [0, 2 if free_a else 1, 2, 3, 3 if free_b else 4]
+        uniq = sorted(set(slots))
+        P = np.zeros((10, 2 * len(uniq)))
+        for k, node in enumerate(slots):
+            P[2 * k:2 * k + 2, 2 * uniq.index(node):2 * uniq.index(node) + 2] = np.eye(2)
+        y0 = np.concatenate([x0[2 * node:2 * node + 2] for node in uniq])
+        lam = np.array([rng.choice([0.0, 0.5])])
+        eps, area = np.array([rng.uniform(10, 100)]), np.array([0.3])
+
+        def ev(y, tangent=False):
+            return node_to_smooth_segment((P @ y)[None], lam, eps, area, tangent)
+
+        g, xi, p, f, K, W = ev(y0, True)
+        assert p[0] > 0 and 0.0 <= xi[0] <= 1.0
+        assert abs(smooth_gap((P @ y0)[None])[0][0] - g[0]) < 1e-15
+        fc, Kc = P.T @ f[0], P.T @ K[0] @ P
+        h = 1e-6
+        m = len(y0)
+        fd_f, fd_K = np.zeros(m), np.zeros((m, m))
+        for j in range(m):
+            e = np.zeros(m)
+            e[j] = h
+            fd_f[j] = (ev(y0 + e)[5][0] - ev(y0 - e)[5][0]) / (2 * h)
+            fd_K[:, j] = P.T @ (ev(y0 + e)[3][0] - ev(y0 - e)[3][0]) / (2 * h)
+        assert np.abs(fc - fd_f).max() < 1e-7 * np.abs(fc).max()
+        assert np.abs(Kc - fd_K).max() < 1e-6 * np.abs(Kc).max()
+
+
+def test_smooth_curve_is_c1_across_vertices():
+    """A slave at a master vertex, seen from either segment: the same gap, the same normal and
+    the same nodal forces (the straight segments' normals differ there by the vertex angle)."""
+    from dolfinx_corot.contact.kernels2d import node_to_smooth_segment
+
+    rng = np.random.default_rng(2)
+    nodes = _arc_nodes(rng, n=7)
+    v = nodes[3]
+    inward = np.array([-(nodes[4] - nodes[2])[1], (nodes[4] - nodes[2])[0]])
+    inward /= np.linalg.norm(inward)  # ⊥ to the curve's (Catmull–Rom) tangent at the vertex
+    xs = v + 0.02 * inward  # 0.02 inside the master body, on the vertex's normal
+    one = dict(multiplier=np.zeros(1), penalty=np.array([50.0]), area=np.array([0.3]), with_tangent=True)
+    left = node_to_smooth_segment(_pair_x(nodes, 2, xs)[None], *one.values())   # segment 2→3, ξ = 1
+    right = node_to_smooth_segment(_pair_x(nodes, 3, xs)[None], *one.values())  # segment 3→4, ξ = 0
+    assert abs(left[1][0] - 1.0) < 1e-12 and abs(right[1][0]) < 1e-12
+    assert abs(left[0][0] - right[0][0]) < 1e-14 and abs(left[0][0] + 0.02) < 1e-12
+    assert np.allclose(right[3][0][0:2], left[3][0][0:2], atol=1e-13)  # slave force: same normal
+    # on the vertex, both segments hand the whole reaction to the vertex node
+    assert np.allclose(left[3][0][6:8], -left[3][0][0:2], atol=1e-12)
+    assert np.allclose(right[3][0][4:6], -right[3][0][0:2], atol=1e-12)
+
+
+def test_smooth_curve_keeps_an_even_straight_surface_straight():
+    """On evenly divided collinear nodes (and at free ends) the Hermite curve is the segment
+    itself, linearly parametrized: gap and ξ are those of the straight kernel."""
+    from dolfinx_corot.contact.kernels2d import smooth_gap
+
+    nodes = np.column_stack([np.linspace(3.0, 0.0, 7), np.zeros(7)])
+    rng = np.random.default_rng(4)
+    for j in range(6):
+        xs = np.array([rng.uniform(nodes[j + 1, 0], nodes[j, 0]), rng.uniform(-0.1, 0.1)])
+        x = _pair_x(nodes, j, xs, free_a=(j == 0), free_b=(j == 5))
+        g, xi, ok = smooth_gap(x[None])
+        g0, xi0 = gap(xs[None], nodes[j][None], nodes[j + 1][None])
+        assert ok[0] and abs(g[0] - g0[0]) < 1e-14 and abs(xi[0] - xi0[0]) < 1e-12

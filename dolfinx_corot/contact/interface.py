@@ -261,7 +261,6 @@ class Interface:
         self.anchor = None  # slave and master positions at the last search
         self.pairs_changed = True
         self.active = np.full(n, -1)
-        self.frozen = False
         self._assigned = None
 
     def _positions(self, surf) -> np.ndarray:
@@ -303,11 +302,10 @@ class Interface:
                     (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)))
         # narrow phase over this rank's candidates on the smooth surface: each slave takes the
         # segment on which its closest point falls inside [0, 1] (a little beyond a free end of
-        # the surface) with the smallest |g|. A slave outside a sharp
-        # convex corner has none: it meets the corner's vertex (node-to-vertex). Once frozen
-        # (late Newton iterations) a slave keeps its assignment.
-        if not (self.frozen and self._assigned is not None):
-            self._assigned = self._assign(xs, xm, mine_pairs)
+        # the surface) with the smallest |g|, chosen afresh at every evaluation (the smooth curve
+        # makes the choice continuous). A slave outside a sharp convex corner has none: it meets
+        # the corner's vertex (node-to-vertex).
+        self._assigned = self._assign(xs, xm, mine_pairs)
         segment, mode = self._assigned
         s = self.mine[segment[self.mine] >= 0]
         m = segment[s]
@@ -457,7 +455,6 @@ class ContactSet:
     """The interfaces of a scene bound to one system: adds their forces to f_int and their
     tangent to the system matrix through a matrix over the candidate pairs."""
 
-    FREEZE_AFTER = 10**9
 
     def __init__(self, interfaces, system):
         self.interfaces = list(interfaces)
@@ -475,19 +472,15 @@ class ContactSet:
         self.project = False
 
     def begin_newton(self) -> None:
-        """A Newton solve starts: slaves may choose their master segments again."""
-        self.evaluations = 0
+        """A Newton solve starts: its first tangent is the exact one."""
+        self.project = False
 
     def add_force(self, fint: PETSc.Vec) -> None:
-        """Evaluate every interface at the current configuration; fint += contact forces.
-
-        After ``FREEZE_AFTER`` evaluations of one Newton solve the slaves keep their master
-        segments (the search still runs: the pattern follows the bodies)."""
+        """Evaluate every interface at the current configuration (search, pairs, kernels);
+        fint += contact forces."""
         t = time.perf_counter()
         self._blocks = []
-        self.evaluations = getattr(self, "evaluations", 0) + 1
         for itf in self.interfaces:
-            itf.frozen = self.evaluations > self.FREEZE_AFTER
             dofs, f, K, pairs = itf.evaluate()
             self._blocks.append((dofs, K, pairs))
             fint.setValues(dofs.ravel().astype(PETSc.IntType), f.ravel(), addv=PETSc.InsertMode.ADD_VALUES)

@@ -218,6 +218,62 @@ def test_swapping_the_bodies_of_symmetric_contact_changes_nothing():
         assert np.abs(runs[0] - runs[1]).max() < 1e-10 * np.abs(runs[0]).max()
 
 
+def test_a_beam_master_is_two_sided():
+    """A plate (beam, depth 0.1) between two soil blocks, its faces touching both: the soil nodes
+    above and below are slaves of the same beam elements. Pushed down at mid-span, the plate
+    presses mostly on the lower block (its bent ends rise against the upper one); pulled up, the
+    mirror image: the model is symmetric about the plate's axis, so the reactions swap exactly
+    (to 1e-8), and the fixed edges together carry the load (to 1e-8)."""
+    from dolfinx_corot.assembly import make_system
+
+    F = 2.0
+    tm = rectangles({"below": (0.0, -1.0, 3.0, 1.0, 12, 4), "above": (0.0, 0.1, 3.0, 1.0, 12, 4)},
+                    {"below_base": [("below", "bottom")], "below_top": [("below", "top")],
+                     "above_top": [("above", "top")], "above_bottom": [("above", "bottom")]}, comm=comm)
+    xb = np.linspace(0.5, 2.5, 11)
+    plate = dc.io.mesh.from_arrays(np.column_stack([xb, np.full_like(xb, 0.05)]),
+                                   np.column_stack([np.arange(10), np.arange(1, 11)]), "plate",
+                                   point_groups={"mid": np.array([5])}, comm=comm)
+    results = {}
+    for direction in (-1.0, 1.0):
+        sc = dc.Scene()
+        soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(100.0, 0.3), degree=1)
+        beam = sc.add_beam(plate, section=dc.Rectangle(1.0, 0.1), material=dc.Elastic(1.0e4, 0.3))
+        sc.fix(soil, "below_base")
+        sc.fix(soil, "above_top")
+        sc.fix(beam, "mid", dofs=("ux",))
+        sc.load(beam, "mid", force=(0.0, direction * F))
+        sc.monitor_reaction("below", soil, "below_base")
+        sc.monitor_reaction("above", soil, "above_top")
+        law = dc.AugmentedLagrangian()
+        sc.contact(slaves=(soil, "below_top"), masters=(beam, "plate"), law=law)
+        sc.contact(slaves=(soil, "above_bottom"), masters=(beam, "plate"), law=law)
+        system = make_system(sc.model, contacts=sc.interfaces)
+        res = dc.solve(sc, dc.LoadControl(steps=2), system=system)
+        system.destroy()
+        row = res.history.rows[-1]
+        results[direction] = (row["below_Fy"], row["above_Fy"], [itf.pressure()[1].max() for itf in sc.interfaces])
+    (b_down, a_down, p_down), (b_up, a_up, p_up) = results[-1.0], results[1.0]
+    assert abs(b_down + a_down - F) < 1e-8 * F and abs(b_up + a_up + F) < 1e-8 * F
+    assert b_down > 0.8 * F and p_down[0] > p_down[1] > 0.0  # mostly on the lower face
+    assert abs(b_down + a_up) < 1e-8 * F and abs(a_down + b_up) < 1e-8 * F  # mirror images
+    assert abs(p_down[0] - p_up[1]) < 1e-8 * p_down[0] and abs(p_down[1] - p_up[0]) < 1e-8 * p_down[0]
+
+
+def test_beam_on_beam_contact_needs_an_explicit_penalty():
+    xb = np.linspace(0.0, 1.0, 5)
+    lines = np.column_stack([np.arange(4), np.arange(1, 5)])
+    sc = dc.Scene()
+    one = sc.add_beam(dc.io.mesh.from_arrays(np.column_stack([xb, 0 * xb]), lines, "one", comm=comm),
+                      section=dc.Rectangle(1.0, 0.1), material=dc.Elastic(1.0e4, 0.3))
+    two = sc.add_beam(dc.io.mesh.from_arrays(np.column_stack([xb, 0 * xb + 0.1]), lines, "two", comm=comm),
+                      section=dc.Rectangle(1.0, 0.1), material=dc.Elastic(1.0e4, 0.3))
+    with pytest.raises(dc.ContactError, match="give it"):
+        sc.contact(slaves=(one, "one"), masters=(two, "two"))
+    (itf,) = sc.contact(slaves=(one, "one"), masters=(two, "two"), law=dc.Penalty(penalty=1.0e5))
+    assert itf.two_sided and np.allclose(itf.master_offset, 0.05) and np.allclose(itf.slave_offset, 0.05)
+
+
 def test_stale_candidates_are_no_partners():
     """Candidate pairs left from a far-off configuration (e.g. a diverged Newton iterate) do not
     act: a slave whose only candidates are on the far side of the master body (a valid closest
@@ -277,18 +333,20 @@ def test_an_idle_interface_changes_nothing_and_builds_no_matrix():
         assert np.abs(results[0] - results[1]).max() < 1e-14, np.abs(results[0] - results[1]).max()
 
 
-def test_beam_nodes_as_slaves_on_a_soil_block():
-    """Continuum–beam contact (seed §3.1.1, figure 3.2): a beam lying on a soil block (two meshes,
-    one coupled system), pressed at mid-span; the beam's nodes are slaves of the soil's top. The
-    whole load passes through contact: soil base reaction = load (to 1e-8), the contact pressure
-    spreads over several nodes, and the beam deflects."""
+@pytest.mark.parametrize("direction", ["beam slaves", "beam master", "symmetric"])
+def test_beam_on_a_soil_block(direction):
+    """Continuum–beam contact (seed §3.1.1, figure 3.2): a beam (depth 0.2) lying on a soil block
+    (two meshes, one coupled system), pressed at mid-span; its nodes slaves of the soil's top, its
+    elements masters of the soil's top nodes (their surface half the depth below the axis), or
+    both. The whole load passes through contact: soil base reaction = load (to 1e-8), the
+    pressure spreads over several nodes, and the beam deflects."""
     from dolfinx_corot.assembly import make_system
 
     F = 5.0
     soil_mesh = rectangles({"soil": (0.0, -1.0, 4.0, 1.0, 16, 4)},
                            {"soil_base": [("soil", "bottom")], "soil_top": [("soil", "top")]}, comm=comm)
     xb = np.linspace(0.5, 3.5, 13)
-    beam_mesh = dc.io.mesh.from_arrays(np.column_stack([xb, np.zeros_like(xb)]),
+    beam_mesh = dc.io.mesh.from_arrays(np.column_stack([xb, np.full_like(xb, 0.1)]),
                                        np.column_stack([np.arange(12), np.arange(1, 13)]), "beam",
                                        point_groups={"left": np.array([0]), "mid": np.array([6])}, comm=comm)
     sc = dc.Scene()
@@ -299,14 +357,24 @@ def test_beam_nodes_as_slaves_on_a_soil_block():
     sc.load(beam, "mid", force=(0.0, -F))
     sc.monitor_reaction("base", soil, "soil_base")
     sc.monitor("mid", beam, "mid")
-    (itf,) = sc.contact(slaves=(beam, "beam"), masters=(soil, "soil_top"), law=dc.AugmentedLagrangian())
-    with pytest.raises(dc.ContactError, match="beams as master"):
-        sc.contact(slaves=(soil, "soil_top"), masters=(beam, "beam"))
+    law = dc.AugmentedLagrangian()
+    if direction == "beam master":
+        made = sc.contact(slaves=(soil, "soil_top"), masters=(beam, "beam"), law=law)
+    else:
+        made = sc.contact(slaves=(beam, "beam"), masters=(soil, "soil_top"), law=law,
+                          symmetric=direction == "symmetric")
     system = make_system(sc.model, contacts=sc.interfaces)
     res = dc.solve(sc, dc.LoadControl(steps=2), system=system)
     system.destroy()
+    assert res.history.column("cuts").sum() == 0
     assert abs(res.history.column("base_Fy")[-1] - F) < 1e-8 * F
-    x, p = itf.pressure()
     # Σ A p is the load up to the tilt of the indented soil's normals (cos θ ≈ 0.9996 here)
-    assert abs(np.sum(p * itf.area) - F) < 1e-2 * F and np.count_nonzero(p) >= 5
+    total = sum(float(np.sum(itf.pressure()[1] * itf.area)) for itf in made)
+    assert abs(total - F) < 1e-2 * F
+    assert min(np.count_nonzero(itf.pressure()[1]) for itf in made) >= 5
+    # the gaps close at the beam's face, half its depth below the axis
+    for itf in made:
+        s, g = itf.gaps()
+        closed = itf.multiplier[s] > 0.0
+        assert comm.allreduce(float(np.abs(g[closed]).max(initial=0.0)), op=MPI.MAX) < 1e-3 * itf.h
     assert res.history.column("mid_uy")[-1] < 0.0

@@ -96,7 +96,7 @@ def test_node_to_vertex_force_and_tangent_match_finite_differences(multiplier):
         eps, area, lam = np.array([rng.uniform(10, 1000)]), np.array([0.7]), np.array([multiplier])
 
         def ev(x, tangent=False):
-            return node_to_vertex(x[None, 0:2], x[None, 2:4], nbar[None], lam, eps, area, tangent)
+            return node_to_vertex(x[None, 0:2], x[None, 2:4], nbar[None], np.zeros(1), lam, eps, area, tangent)
 
         g, p, f, K = ev(x0, True)
         assert g[0] < 0 and p[0] > 0
@@ -124,7 +124,7 @@ def test_node_to_vertex_continues_node_to_segment_at_the_segment_end():
     lam, eps, area = np.array([1.0]), np.array([100.0]), np.array([0.5])
     g, xi, p, f, K, W = node_to_segment(xs[None], x1[None], x2[None], lam, eps, area, True)
     assert abs(xi[0] - 1.0) < 1e-15
-    gv, pv, fv, Kv = node_to_vertex(xs[None], x2[None], np.array([[0.0, -1.0]]), lam, eps, area, True)
+    gv, pv, fv, Kv = node_to_vertex(xs[None], x2[None], np.array([[0.0, -1.0]]), np.zeros(1), lam, eps, area, True)
     assert abs(gv[0] - g[0]) < 1e-15 and abs(pv[0] - p[0]) < 1e-12
     assert np.abs(fv[0] - f[0][[0, 1, 4, 5]]).max() < 1e-12
 
@@ -144,11 +144,13 @@ def _pair_x(nodes, j, xs, free_a=False, free_b=False):
     return np.concatenate([xs, nodes[p], nodes[j], nodes[j + 1], nodes[q]])
 
 
+@pytest.mark.parametrize("side", [1, -1], ids=["surface", "beam-underside"])
 @pytest.mark.parametrize("ends", ["inside", "free a", "free b", "free both"])
-def test_smooth_kernel_force_and_tangent_match_finite_differences(ends):
+def test_smooth_kernel_force_and_tangent_match_finite_differences(ends, side):
     """f = ∂Φ/∂x and K = ∂f/∂x of the smooth-curve kernel by central differences at random
-    penetrating slaves on a jittered arc (penalty and augmented Lagrangian). At a free end
-    p = a (or q = b) is one node: the derivatives are those of the node's summed columns."""
+    penetrating slaves on a jittered arc (penalty and augmented Lagrangian), on the outer side of
+    a body's surface or (side −1, offset) on the far side of a beam's axis. At a free end p = a
+    (or q = b) is one node: the derivatives are those of the node's summed columns."""
     from dolfinx_corot.contact.kernels2d import node_to_smooth_segment, smooth_gap
 
     rng = np.random.default_rng(11)
@@ -157,7 +159,9 @@ def test_smooth_kernel_force_and_tangent_match_finite_differences(ends):
         nodes = _arc_nodes(rng)
         a, b = nodes[2], nodes[3]
         t = (b - a) / np.linalg.norm(b - a)
-        xs = a + rng.uniform(0.1, 0.9) * (b - a) + rng.uniform(0.01, 0.05) * np.array([-t[1], t[0]])
+        depth = rng.uniform(0.01, 0.05)
+        offset = np.array([0.0 if side == 1 else depth + 0.03])
+        xs = a + rng.uniform(0.1, 0.9) * (b - a) + depth * np.array([-t[1], t[0]])
         x0 = _pair_x(nodes, 2, xs, free_a, free_b)
         # independent coordinates: slave, (p), a, b, (q); P maps them to the 10 entries
         slots = [0, 2 if free_a else 1, 2, 3, 3 if free_b else 4]
@@ -170,11 +174,11 @@ def test_smooth_kernel_force_and_tangent_match_finite_differences(ends):
         eps, area = np.array([rng.uniform(10, 100)]), np.array([0.3])
 
         def ev(y, tangent=False):
-            return node_to_smooth_segment((P @ y)[None], lam, eps, area, tangent)
+            return node_to_smooth_segment((P @ y)[None], np.array([float(side)]), offset, lam, eps, area, tangent)
 
         g, xi, p, f, K, W = ev(y0, True)
         assert p[0] > 0 and 0.0 <= xi[0] <= 1.0
-        assert abs(smooth_gap((P @ y0)[None])[0][0] - g[0]) < 1e-15
+        assert abs(side * smooth_gap((P @ y0)[None])[0][0] - offset[0] - g[0]) < 1e-15
         fc, Kc = P.T @ f[0], P.T @ K[0] @ P
         h = 1e-6
         m = len(y0)
@@ -199,7 +203,8 @@ def test_smooth_curve_is_c1_across_vertices():
     inward = np.array([-(nodes[4] - nodes[2])[1], (nodes[4] - nodes[2])[0]])
     inward /= np.linalg.norm(inward)  # ⊥ to the curve's (Catmull–Rom) tangent at the vertex
     xs = v + 0.02 * inward  # 0.02 inside the master body, on the vertex's normal
-    one = dict(multiplier=np.zeros(1), penalty=np.array([50.0]), area=np.array([0.3]), with_tangent=True)
+    one = dict(side=np.ones(1), offset=np.zeros(1), multiplier=np.zeros(1), penalty=np.array([50.0]),
+               area=np.array([0.3]), with_tangent=True)
     left = node_to_smooth_segment(_pair_x(nodes, 2, xs)[None], *one.values())   # segment 2→3, ξ = 1
     right = node_to_smooth_segment(_pair_x(nodes, 3, xs)[None], *one.values())  # segment 3→4, ξ = 0
     assert abs(left[1][0] - 1.0) < 1e-12 and abs(right[1][0]) < 1e-12

@@ -148,7 +148,8 @@ def _gather_surface(model, seg_blocks: np.ndarray, Xdof: np.ndarray, where: str)
 
 def _beam_surface(model, where: str) -> dict:
     """Nodes and segments (the elements) of the line group ``where`` of a 2D beam part: the beam's
-    axis is the contact line; its nodes may be slaves (their translations take the force)."""
+    axis offset by half the section's depth on either side is the contact surface; its nodes may
+    be slaves or its elements masters (their translations take the force)."""
     tm = model.tmesh
     cells = tm.cells(where)
     n_owned = tm.mesh.topology.index_map(1).size_local
@@ -156,6 +157,11 @@ def _beam_surface(model, where: str) -> dict:
     seg_blocks = np.array([model.V.dofmap.cell_dofs(c) for c in cells], dtype=np.int64).reshape(-1, 2)
     surf = _gather_surface(model, seg_blocks, model.V.tabulate_dof_coordinates()[:, :2], where)
     surf["beam"] = True
+    # half the depth of each element's section: √(12 EI/EA)/2 (exact for rectangles; 0 for bars)
+    props = model.props.x.array.reshape(-1, model.nprops)[model._prop_blocks[cells]]
+    EA, EI = props[:, 0], props[:, 1]
+    half = 0.5 * np.sqrt(12.0 * EI / np.where(EA > 0.0, EA, 1.0)) * (EA > 0.0)
+    surf["half_thickness"] = np.concatenate(model.comm.allgather(half))
     return surf
 
 
@@ -210,13 +216,18 @@ class Interface:
         self.slave_spec, self.master_spec, self.law = slaves, masters, law
         self.slave = boundary_surface(*slaves)
         self.master = boundary_surface(*masters)
-        if self.master.get("beam"):
-            raise ContactError(f"contact '{masters[1]}': beams as master segments are not supported yet "
-                               "(make the beam's nodes the slaves and the other body's boundary the master)")
         self.name = f"{slaves[1]} -> {masters[1]}"
         # slaves: all nodes of the slave group; their tributary lengths on the slave boundary
         self.area = _tributary_lengths(self.slave["X"], self.slave["segments"])
         Xm, sm = self.master["X"], self.master["segments"]
+        # beams: contact on either side of the axis, at half the section's depth from it
+        self.two_sided = bool(self.master.get("beam"))
+        self.master_offset = self.master.get("half_thickness", np.zeros(len(sm)))
+        self.slave_offset = np.zeros(len(self.area))
+        if self.slave.get("beam"):
+            ss = self.slave["segments"]
+            np.maximum.at(self.slave_offset, ss[:, 0], self.slave["half_thickness"])
+            np.maximum.at(self.slave_offset, ss[:, 1], self.slave["half_thickness"])
         self.h = float(np.mean(np.linalg.norm(Xm[sm[:, 1]] - Xm[sm[:, 0]], axis=1)))
         if law.penalty is not None:
             if not law.penalty > 0.0:
@@ -230,6 +241,9 @@ class Interface:
                 m = surf["model"]
                 E, nu = m.E.x.array, m.nu.x.array
                 moduli.append(m.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN))
+            if not moduli:
+                raise ContactError(f"contact '{self.name}': between two beams the penalty has no solid to scale "
+                                   "with: give it, e.g. dc.Penalty(penalty=...)")
             self.penalty = law.factor * min(moduli) / self.h
         self.valence = np.bincount(sm.ravel(), minlength=len(Xm))  # segments at each master node
         # nodes (p, a, b, q) of each segment's curve; p = a, q = b: the straight segment
@@ -276,7 +290,9 @@ class Interface:
         if moved <= 0.5 * self.margin:
             return
         seg = self.master["segments"]
-        pairs = broad_phase(xs[self.mine], xm[seg[:, 0]], xm[seg[:, 1]], self.margin)
+        # beams: the surfaces lie up to half their depth from the axes the search sees
+        reach = self.margin + self.slave_offset.max(initial=0.0) + self.master_offset.max(initial=0.0)
+        pairs = broad_phase(xs[self.mine], xm[seg[:, 0]], xm[seg[:, 1]], reach)
         pairs[:, 0] = self.mine[pairs[:, 0]]
         union = np.unique(np.vstack([self.candidates, pairs]), axis=0)
         grown = self.comm.allreduce(int(len(union) > len(self.candidates)), op=MPI.MAX)
@@ -306,7 +322,7 @@ class Interface:
         # makes the choice continuous). A slave outside a sharp convex corner has none: it meets
         # the corner's vertex (node-to-vertex).
         self._assigned = self._assign(xs, xm, mine_pairs)
-        segment, mode = self._assigned
+        segment, mode, sides = self._assigned
         s = self.mine[segment[self.mine] >= 0]
         m = segment[s]
         self.active[:] = -1
@@ -321,8 +337,9 @@ class Interface:
         if on.any():
             i = np.flatnonzero(on)
             x = np.hstack([xs[s[i]], xm[ext[i, 0]], xm[ext[i, 1]], xm[ext[i, 2]], xm[ext[i, 3]]])
-            g[i], _, _, f[i], K[i], _ = node_to_smooth_segment(x, lam[i], eps[i], self.area[s[i]], True,
-                                                               self.touch)
+            offset = self.slave_offset[s[i]] + self.master_offset[m[i]]
+            g[i], _, _, f[i], K[i], _ = node_to_smooth_segment(x, sides[s[i]], offset, lam[i], eps[i],
+                                                               self.area[s[i]], True, self.touch)
         if (~on).any():
             normals = self._vertex_normals(xm)
             for k in (1, 2):
@@ -330,8 +347,8 @@ class Interface:
                 if not len(i):
                     continue
                 v = ext[i, k]
-                gv, _, fv, Kv = node_to_vertex(xs[s[i]], xm[v], normals[v], lam[i], eps[i], self.area[s[i]],
-                                               True, self.touch)
+                gv, _, fv, Kv = node_to_vertex(xs[s[i]], xm[v], normals[v], self.slave_offset[s[i]], lam[i],
+                                               eps[i], self.area[s[i]], True, self.touch)
                 idx = np.array([0, 1, 2 * k + 2, 2 * k + 3])
                 g[i] = gv
                 f[np.ix_(i, idx)] = fv
@@ -344,12 +361,15 @@ class Interface:
         return dofs[keep], f[keep], K[keep], (s[keep], m[keep])
 
     def _assign(self, xs, xm, pairs):
-        """(segment (n_slaves,), mode (n_slaves,)) of this rank's candidate pairs: mode 0 on the
-        segment, 1 / 2 at its vertex a / b (a sharp corner); segment −1: no contact partner."""
+        """(segment, mode, side), each (n_slaves,), of this rank's candidate pairs: mode 0 on the
+        segment, 1 / 2 at its vertex a / b (a sharp corner); segment −1: no contact partner; side
+        −1 for a slave on the far side of a beam's axis (two-sided masters), else 1."""
         n = len(self.area)
         ext = self.ext[pairs[:, 1]]
         x = np.hstack([xs[pairs[:, 0]]] + [xm[ext[:, j]] for j in range(4)])
         g, xi, ok = smooth_gap(x)
+        side = np.where(g < 0.0, -1.0, 1.0) if self.two_sided else np.ones(len(g))
+        g = side * g - self.slave_offset[pairs[:, 0]] - self.master_offset[pairs[:, 1]]
         lo = np.where(self.valence[ext[:, 1]] >= 2, -1e-9, -self.XI_TOLERANCE)
         hi = np.where(self.valence[ext[:, 2]] >= 2, 1.0 + 1e-9, 1.0 + self.XI_TOLERANCE)
         # a pair counts within the search margin outside and one mean segment length inside: the
@@ -358,11 +378,13 @@ class Interface:
         valid = ok & (xi >= lo) & (xi <= hi) & (g > -self.h) & (g < self.margin)
         segment = np.full(n, -1)
         mode = np.zeros(n, dtype=np.int64)
+        sides = np.ones(n)
         if valid.any():
             v = np.flatnonzero(valid)
             order = np.lexsort((pairs[v, 1], np.abs(g[v]), pairs[v, 0]))  # by slave, |g|, segment
             first = v[order][np.r_[True, np.diff(pairs[v[order], 0]) != 0]]
             segment[pairs[first, 0]] = pairs[first, 1]
+            sides[pairs[first, 0]] = side[first]
         # slaves without a projection: the closest point of the straight surface, if it is a sharp
         # vertex shared by two segments (outside a convex corner) within the search margin
         rest = pairs[segment[pairs[:, 0]] < 0]
@@ -375,9 +397,10 @@ class Interface:
             sharp = np.where(end == 0, self.ext[m, 0] == self.ext[m, 1], self.ext[m, 3] == self.ext[m, 2])
             close = np.linalg.norm(xs - xm[vertex], axis=1) < self.margin
             corner = (near >= 0) & ((t < 0.0) | (t > 1.0)) & (self.valence[vertex] >= 2) & sharp & close
+            corner &= not self.two_sided  # a beam's kinks are rounded by its thickness: not modelled
             segment[corner] = near[corner]
             mode[corner] = 1 + end[corner]
-        return segment, mode
+        return segment, mode, sides
 
     def _vertex_normals(self, xm: np.ndarray) -> np.ndarray:
         """Unit averaged outward normals (n_master, 2) of the master nodes (current)."""

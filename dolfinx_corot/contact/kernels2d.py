@@ -136,7 +136,7 @@ def node_to_segment(xs, x1, x2, multiplier, penalty, area, with_tangent, touch=0
 
 
 @numba.njit(cache=True)
-def node_to_vertex(xs, xv, normal, multiplier, penalty, area, with_tangent, touch=0.0):
+def node_to_vertex(xs, xv, normal, offset, multiplier, penalty, area, with_tangent, touch=0.0):
     r"""Contact of slaves with master vertices (the closest point of the master surface is a
     vertex shared by two segments).
 
@@ -148,8 +148,9 @@ def node_to_vertex(xs, xv, normal, multiplier, penalty, area, with_tangent, touc
     At the edge of a segment's region (ξ = 0 or 1) this gap and its gradient equal the
     segment's, so a slave passes from segment to vertex to segment without a jump.
 
-    xs, xv: (k, 2); normal: (k, 2) averaged unit normals at the vertices; multiplier,
-    penalty, area: (k,). Returns g, p: (k,); f: (k, 4) on (x_s, x_v); K: (k, 4, 4)."""
+    xs, xv: (k, 2); normal: (k, 2) averaged unit normals at the vertices; offset (k,) subtracted
+    from the gap (half the depth of a beam whose node is the slave); multiplier, penalty, area:
+    (k,). Returns g, p: (k,); f: (k, 4) on (x_s, x_v); K: (k, 4, 4)."""
     k = xs.shape[0]
     g = np.empty(k)
     p = np.zeros(k)
@@ -160,7 +161,7 @@ def node_to_vertex(xs, xv, normal, multiplier, penalty, area, with_tangent, touc
         dy = xs[i, 1] - xv[i, 1]
         dist = np.sqrt(dx * dx + dy * dy)
         s = 1.0 if dx * normal[i, 0] + dy * normal[i, 1] >= 0.0 else -1.0
-        g[i] = s * dist
+        g[i] = s * dist - offset[i]
         eps = penalty[i]
         pi = multiplier[i] - eps * g[i]
         if pi < -eps * touch or dist == 0.0:
@@ -307,19 +308,23 @@ def smooth_gap(x):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def node_to_smooth_segment(x, multiplier, penalty, area, with_tangent, touch=0.0):
+def node_to_smooth_segment(x, side, offset, multiplier, penalty, area, with_tangent, touch=0.0):
     r"""Contact force and tangent of k slaves on the segments of a C¹ master curve.
 
     Each master segment a → b is replaced by the cubic Hermite curve through x_a and x_b with the
     nodal tangents (x_b − x_p)/2 and (x_q − x_a)/2 (Catmull–Rom; p and q the neighbouring nodes on
     the surface; p = a or q = b at a sharp corner or a free end, where the curve ends with zero
-    curvature): neighbouring segments share the tangent at their common node, so the surface, its normal and the gap are continuous
-    with their first derivatives when a slave passes from one segment to the next (the straight
-    segments turn their normal abruptly there; Wriggers 2006, §9.4; Padmanabhan & Laursen 2001).
-    A straight, evenly divided surface stays the straight segments. The closest point x(ξ)
-    solves (x_s − x(ξ))·x'(ξ) = 0 (Newton), g = (x_s − x(ξ))·n with n ⊥ x'.
+    curvature): neighbouring segments share the tangent at their common node, so the surface, its
+    normal and the gap are continuous with their first derivatives when a slave passes from one
+    segment to the next (the straight segments turn their normal abruptly there; Wriggers 2006,
+    §9.4; Padmanabhan & Laursen 2001). A straight, evenly divided surface stays the straight
+    segments. The closest point x(ξ) solves (x_s − x(ξ))·x'(ξ) = 0 (Newton), and the gap is
+    g = s (x_s − x(ξ))·n − c with n ⊥ x': s = ±1 the side of the curve the contact is on (−1: a
+    slave on the body's side of a beam's axis) and c ≥ 0 an offset (half the thicknesses of beams,
+    whose axes are the curves).
 
-    x: (k, 10) current positions (x_s, x_p, x_a, x_b, x_q); multiplier, penalty, area: (k,).
+    x: (k, 10) current positions (x_s, x_p, x_a, x_b, x_q); side, offset, multiplier, penalty,
+    area: (k,).
     Returns g, ξ, p: (k,); f: (k, 10); K: (k, 10, 10); energy (k,). Pressure law, force and
     tangent as :func:`node_to_segment` (f = −A p N, K = A(ε N Nᵀ − p ∂²g), ∂²g by complex step
     of N, the projection re-solved in complex arithmetic)."""
@@ -339,7 +344,9 @@ def node_to_smooth_segment(x, multiplier, penalty, area, with_tangent, touch=0.0
         if not ok:
             g[i] = np.inf
             continue
-        gi = _smooth_gap_gradient(x[i], N, xii)
+        gi = side[i] * _smooth_gap_gradient(x[i], N, xii) - offset[i]
+        for r in range(10):
+            N[r] *= side[i]
         g[i] = gi
         eps = penalty[i]
         pi = multiplier[i] - eps * gi
@@ -363,7 +370,7 @@ def node_to_smooth_segment(x, multiplier, penalty, area, with_tangent, touch=0.0
             xic, _ = _closest_on_curve(xc, xii + 0j, 3)
             _smooth_gap_gradient(xc, Nc, xic)
             for r in range(10):
-                K[i, r, c] -= a * pi * Nc[r].imag / _H
+                K[i, r, c] -= a * pi * side[i] * Nc[r].imag / _H
         for r in range(10):
             for c in range(r + 1, 10):
                 s = 0.5 * (K[i, r, c] + K[i, c, r])

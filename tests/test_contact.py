@@ -76,6 +76,29 @@ def test_one_pass_contact_fails_the_patch_test_as_known():
         assert _linear_field_error(X, u) > 1e-4
 
 
+def test_augmented_lagrangian_under_arc_length():
+    """Arc-length steps with augmented-Lagrangian contact: after each converged step the Uzawa
+    updates (at that load factor) drive the penetration below the tolerance; equilibrium holds."""
+    tm = _two_blocks(3, 4)
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+    sc.fix(b, "base", dofs=("uy",))
+    sc.fix(b, "left", dofs=("ux",))
+    sc.load(b, "top", traction=(0.0, -P))
+    (itf,) = sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"),
+                        law=dc.AugmentedLagrangian(gap_tolerance=1e-6), smooth=False)
+    sc.monitor_reaction("base", b, "base")
+    res = dc.solve(sc, dc.ArcLength(initial_increment=0.3, max_load_factor=1.0, max_steps=6))
+    hist = res.history
+    assert hist.column("uzawa_updates").min() >= 1
+    lam = hist.column("load_factor")
+    np.testing.assert_allclose(hist.column("base_Fy"), lam * P, rtol=1e-8)
+    s, g = itf.gaps()
+    closed = itf.multiplier[s] > 0.0
+    assert comm.allreduce(float(np.abs(g[closed]).max(initial=0.0)), op=MPI.MAX) < 1e-6 * itf.h
+    assert comm.allreduce(int(closed.sum()), op=MPI.SUM) == 5
+
+
 def test_contact_errors_name_the_culprit():
     tm = _two_blocks(2, 3)
     sc = dc.Scene()
@@ -301,7 +324,8 @@ def test_stale_candidates_are_no_partners():
     u[:, 1] = np.where(X[:, 1] > 1.05, -0.11, 0.0)
     itf.anchor = None
     fresh = itf.evaluate()
-    itf.candidates = np.unique(np.vstack([itf.candidates, [(s, m) for s in itf.mine for m in bottom]]), axis=0)
+    stale_pairs = np.array([(s, m) for s in itf.mine for m in bottom], dtype=np.int64).reshape(-1, 2)
+    itf.candidates = np.unique(np.vstack([itf.candidates, stale_pairs]), axis=0)
     itf.anchor = (itf._positions(itf.slave), itf._positions(itf.master))
     stale = itf.evaluate()
     assert comm.allreduce(len(fresh[3][0]), op=MPI.SUM) == 4

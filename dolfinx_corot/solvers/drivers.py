@@ -269,12 +269,16 @@ class ArcLength:
             dlam_prev, have_prev = state["dlam_prev"], state["have_prev"]
             lam = run.load_factor
             system.global_to_vector(arrays, "Dx_prev", Dx_prev)
+        contact = getattr(system, "contact", None)
         while run.step < self.max_steps:
             cp = system.checkpoint()
             started = run.begin()
             report = NewtonReport(False, 0)
+            if contact is not None:
+                contact.begin_step()
             try:
-                # predictor along the tangent
+                # predictor along the tangent (of the converged state: contact pairs evaluated there)
+                system.residual(lam)
                 system.jacobian()
                 system.solve(f, dxt)
                 tnorm = math.sqrt(dxt.dot(dxt) + psi2F)
@@ -339,6 +343,17 @@ class ArcLength:
                         break
                 else:
                     report.reason = f"no convergence in {opts.max_iterations} iterations: |r| = {norm:.3e}"
+                # augmented-Lagrangian contact: Uzawa updates at the converged load factor, each
+                # followed by Newton at that load factor (the arc-length constraint then holds to
+                # the size of these corrections)
+                while ok and contact is not None and contact.augment():
+                    again = newton(system, lam + Dlam, opts)
+                    report.uzawa += 1
+                    report.iterations += again.iterations
+                    report.residuals += again.residuals
+                    ok = again.converged
+                    if not ok:
+                        report.reason = f"after an augmented-Lagrangian update: {again.reason}"
             except np.linalg.LinAlgError as err:
                 ok = False
                 report.reason = str(err)
@@ -347,7 +362,7 @@ class ArcLength:
                 cuts += 1
                 run.cuts += 1
                 logger.info("arc-length step %d failed (%s); cut %d", run.step + 1, report.reason, cuts)
-                if cuts > self.max_cuts or arc / 2 < arc_min:
+                if arc is None or cuts > self.max_cuts or arc / 2 < arc_min:
                     run.fail(f"arc-length step {run.step + 1} at load factor {lam:.6g}: no convergence after "
                              f"{cuts - 1} cuts (arc length {arc:.3e}); last attempt: {report.reason}")
                 arc /= 2

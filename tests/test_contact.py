@@ -208,6 +208,79 @@ def test_block_slides_over_many_segments_without_friction(press):
     assert comm.allreduce(int(itf.active.max()), op=MPI.MAX) >= 0  # slaves of every rank counted
 
 
+def _hill(radius, half_width=2.0, n_arc=40):
+    """A base block whose top is a circular arc (centre (0, −radius)) from x = −2 to 2, 40 segments,
+    and a unit block resting on its crest, its bottom on the same circle (one mesh, two bodies)."""
+    import gmsh
+
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        g = gmsh.model.geo
+        y_end = np.sqrt(radius**2 - half_width**2) - radius
+        c = g.addPoint(0.0, -radius, 0.0)
+        p = [g.addPoint(-half_width, -1.0, 0), g.addPoint(half_width, -1.0, 0), g.addPoint(half_width, y_end, 0),
+             g.addPoint(-half_width, y_end, 0)]
+        bottom, right, top, left = g.addLine(p[0], p[1]), g.addLine(p[1], p[2]), g.addCircleArc(p[2], c, p[3]), \
+            g.addLine(p[3], p[0])
+        base = g.addPlaneSurface([g.addCurveLoop([bottom, right, top, left])])
+        y_half = np.sqrt(radius**2 - 0.25) - radius  # the block's bottom follows the hill
+        q = [g.addPoint(x, y, 0) for x, y in ((-0.5, y_half), (0.5, y_half), (0.5, 1.0), (-0.5, 1.0))]
+        sb = g.addCircleArc(q[0], c, q[1])
+        sr, st, sl = (g.addLine(q[i], q[(i + 1) % 4]) for i in range(1, 4))
+        slider = g.addPlaneSurface([g.addCurveLoop([sb, sr, st, sl])])
+        g.mesh.setTransfiniteCurve(top, n_arc + 1)
+        for line in (sb, st):
+            g.mesh.setTransfiniteCurve(line, 9)
+        for line in (sr, sl):
+            g.mesh.setTransfiniteCurve(line, 5)
+        g.mesh.setTransfiniteSurface(slider)
+        g.synchronize()
+        for dim, tags, name in ((2, [base], "base_block"), (2, [slider], "slider"), (1, [bottom], "base"),
+                                (1, [top], "hill"), (1, [sb], "slider_bottom"), (1, [st], "slider_top")):
+            gmsh.model.setPhysicalName(dim, gmsh.model.addPhysicalGroup(dim, tags), name)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.2)
+        gmsh.model.mesh.generate(2)
+    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm
+
+
+def test_block_slides_over_a_curved_surface():
+    """A soft block under a vertical load (growing with the push) is pushed 1.5 along a stiff
+    circular hill (radius 10, segments 0.1: its bottom nodes cross 15 of them). Frictionless contact on the smooth master
+    curve: the horizontal force that holds the block equals the vertical load times the slope of
+    the circle at the contact, Σ A p x / Σ A p (y + R) over the slave nodes (to 1e-3 of the
+    load), from 0 at the crest to tan 8.6° at x = 1.5; the vertical load passes through contact
+    alone; no cut, at most 8 iterations per step."""
+    R, push, load = 10.0, 1.5, 0.02
+    tm = _hill(R)
+    sc = dc.Scene()
+    base = sc.add_solid(tm, "base_block", material=dc.NeoHookean(1.0e3, 0.3), degree=1)
+    block = sc.add_solid(tm, "slider", material=dc.NeoHookean(1.0, 0.3), degree=1)
+    sc.fix(base, "base")
+    sc.load(block, "slider_top", traction=(0.0, -load))
+    sc.prescribe(block, "slider_top", ux=push)
+    sc.monitor_reaction("top", block, "slider_top")
+    (itf,) = sc.contact(slaves=(block, "slider_bottom"), masters=(base, "hill"), law=dc.AugmentedLagrangian())
+    rows = []
+
+    def check(row):
+        p = itf.pressure()[1] * itf.area          # nodal forces (nominal pressure × reference length)
+        x = itf.pressure(current=True)[0]        # current positions of the slave nodes
+        slope = np.sum(p * x[:, 0]) / np.sum(p * (x[:, 1] + R))
+        rows.append((row["top_Fx"], row["top_Fy"], row["load_factor"] * load, slope, row["iterations"]))
+
+    res = dc.solve(sc, dc.LoadControl(steps=15), on_step=check)
+    assert res.history.column("cuts").sum() == 0
+    for fx, fy, weight, slope, its in rows:
+        assert abs(fy) < 1e-8 * weight                            # the load passes through contact
+        assert abs(fx + weight * slope) < 1e-3 * weight, (fx, weight * slope)  # the pusher holds it
+        assert its <= 8
+    assert rows[-1][3] > 0.9 * push / np.sqrt(R**2 - push**2)  # the block has moved down the slope
+
+
 @pytest.mark.parametrize("scale", [1e-2, 1.0, 1e4])
 def test_penalty_from_a_hundredth_to_ten_thousand_times_the_default(scale):
     """Penalty contact converges for penalties 1e-2 … 1e4 times the default: equilibrium is exact

@@ -176,7 +176,7 @@ def test_smooth_kernel_force_and_tangent_match_finite_differences(ends, side):
         def ev(y, tangent=False):
             return node_to_smooth_segment((P @ y)[None], np.array([float(side)]), offset, lam, eps, area, tangent)
 
-        g, xi, p, f, K, W = ev(y0, True)
+        g, xi, p, f, K, W, _ = ev(y0, True)
         assert p[0] > 0 and 0.0 <= xi[0] <= 1.0
         assert abs(side * smooth_gap((P @ y0)[None])[0][0] - offset[0] - g[0]) < 1e-15
         fc, Kc = P.T @ f[0], P.T @ K[0] @ P

@@ -209,6 +209,7 @@ class Interface:
 
     XI_TOLERANCE = 0.05  # beyond a free end of the master surface: this far (× length) still on it
     SMOOTH_ANGLE = np.radians(60.0)  # master vertices where the surface turns more than this stay sharp
+    BAND_USES = 3  # corrections per Newton solve that may count lifted pairs as closed
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = True):
         if not isinstance(law, Penalty):
@@ -276,6 +277,9 @@ class Interface:
         self.pairs_changed = True
         self.active = np.full(n, -1)
         self._assigned = None
+        self.first_evaluation = True
+        self.had_contact = False
+        self.band_used = 0
 
     def _positions(self, surf) -> np.ndarray:
         u = surf["model"].state.x.array[surf["ldofs"]]
@@ -311,11 +315,7 @@ class Interface:
         seg = self.master["segments"]
         mine_pairs = self.candidates
         self.active[:] = -1
-        if len(mine_pairs) == 0:
-            self._last = (np.zeros(0, dtype=np.int64), np.zeros(0))
-            self._forces = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 10)))
-            return (np.zeros((0, 10), dtype=np.int64), np.zeros((0, 10)), np.zeros((0, 10, 10)),
-                    (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)))
+        # (a rank without candidates goes on as well: the steps below agree across ranks)
         # narrow phase over this rank's candidates on the smooth surface: each slave takes the
         # segment on which its closest point falls inside [0, 1] (a little beyond a free end of
         # the surface) with the smallest |g|, chosen afresh at every evaluation (the smooth curve
@@ -333,13 +333,51 @@ class Interface:
         f = np.zeros((n, 10))
         K = np.zeros((n, 10, 10))
         lam, eps = self.multiplier[s], np.full(n, self.penalty)
+        touch = self.touch
+        normal = np.zeros((n, 10))
+        # bodies in contact at the start of the Newton solve whose pairs have all opened a little
+        # at an iterate (a tangential step along a curved master lifts a slave) — a body held by
+        # contact alone would have no stiffness there: then the pairs within a tenth of a segment
+        # count as closed for the next correction — penalty stiffness in the tangent, and their
+        # penalty force at the current gap (a pull, in the correction's right-hand side only, see
+        # ContactSet.newton_rhs); the residual keeps the contact law. At most BAND_USES corrections
+        # per Newton solve: bodies that really separate (held otherwise) are then left to do so
+        self._virtual = None
+        for attempt in range(2):
+            self._pair_kernels(xs, xm, s, m, mode, sides, ext, lam, eps, touch, g, f, K, normal)
+            if self.first_evaluation:  # the Newton solve's start: were the bodies in contact?
+                self.first_evaluation = False
+                self.had_contact = bool(self.comm.allreduce(
+                    int(np.any(lam - self.penalty * g >= -self.penalty * self.touch)), op=MPI.MAX))
+            closed = self.comm.allreduce(int(np.any(lam - self.penalty * g > 0.0)), op=MPI.MAX)
+            if closed or attempt or not self.had_contact or self.band_used >= self.BAND_USES:
+                break
+            touch = 0.1 * self.h
+        keep = (lam - self.penalty * g) >= -self.penalty * touch  # closed or touching
+        gd = self.master["gdofs"]
+        dofs = np.hstack([self.slave["gdofs"][s]] + [gd[ext[:, j]] for j in range(4)])
+        if touch > self.touch:
+            pull = keep & (lam - self.penalty * g < 0.0)
+            self._virtual = (s[pull], m[pull],
+                             -(self.area[s[pull]] * (lam[pull] - self.penalty * g[pull]))[:, None] * normal[pull])
+        self._last = (s, g)
+        self._forces = (s[keep], m[keep], f[keep])
+        return dofs[keep], f[keep], K[keep], (s[keep], m[keep])
+
+    def _pair_kernels(self, xs, xm, s, m, mode, sides, ext, lam, eps, touch, g, f, K, normal) -> None:
+        """Gaps, forces, tangents and gap gradients of the assigned pairs into g (n,), f (n, 10),
+        K (n, 10, 10), normal (n, 10) (zero for node-to-vertex pairs)."""
+        g[:] = 0.0
+        f[:] = 0.0
+        K[:] = 0.0
+        normal[:] = 0.0
         on = mode[s] == 0
         if on.any():
             i = np.flatnonzero(on)
             x = np.hstack([xs[s[i]], xm[ext[i, 0]], xm[ext[i, 1]], xm[ext[i, 2]], xm[ext[i, 3]]])
             offset = self.slave_offset[s[i]] + self.master_offset[m[i]]
-            g[i], _, _, f[i], K[i], _ = node_to_smooth_segment(x, sides[s[i]], offset, lam[i], eps[i],
-                                                               self.area[s[i]], True, self.touch)
+            g[i], _, _, f[i], K[i], _, normal[i] = node_to_smooth_segment(x, sides[s[i]], offset, lam[i], eps[i],
+                                                                          self.area[s[i]], True, touch)
         if (~on).any():
             normals = self._vertex_normals(xm)
             for k in (1, 2):
@@ -348,17 +386,11 @@ class Interface:
                     continue
                 v = ext[i, k]
                 gv, _, fv, Kv = node_to_vertex(xs[s[i]], xm[v], normals[v], self.slave_offset[s[i]], lam[i],
-                                               eps[i], self.area[s[i]], True, self.touch)
+                                               eps[i], self.area[s[i]], True, touch)
                 idx = np.array([0, 1, 2 * k + 2, 2 * k + 3])
                 g[i] = gv
                 f[np.ix_(i, idx)] = fv
                 K[np.ix_(i, idx, idx)] = Kv
-        keep = (lam - self.penalty * g) >= -self.penalty * self.touch  # closed or touching
-        gd = self.master["gdofs"]
-        dofs = np.hstack([self.slave["gdofs"][s]] + [gd[ext[:, j]] for j in range(4)])
-        self._last = (s, g)
-        self._forces = (s[keep], m[keep], f[keep])
-        return dofs[keep], f[keep], K[keep], (s[keep], m[keep])
 
     def _assign(self, xs, xm, pairs):
         """(segment, mode, side), each (n_slaves,), of this rank's candidate pairs: mode 0 on the
@@ -495,8 +527,12 @@ class ContactSet:
         self.project = False
 
     def begin_newton(self) -> None:
-        """A Newton solve starts: its first tangent is the exact one."""
+        """A Newton solve starts: its first tangent is the exact one; each interface notes
+        whether its bodies touch at the start."""
         self.project = False
+        for itf in self.interfaces:
+            itf.first_evaluation = True
+            itf.band_used = 0
 
     def add_force(self, fint: PETSc.Vec) -> None:
         """Evaluate every interface at the current configuration (search, pairs, kernels);
@@ -573,6 +609,24 @@ class ContactSet:
         if not self._merged:
             A.setLGMap(*lgmap)  # a new pattern replaces the matrix's internals
             self._merged = True
+
+    def newton_rhs(self, b: PETSc.Vec) -> PETSc.Vec | None:
+        """The right-hand side of the next Newton correction when an interface predicts pairs
+        that are open now to be closed (see :meth:`Interface.evaluate`): b minus their penalty
+        forces at the current gaps, a new vector; None (use b) otherwise."""
+        virtual = [(itf, itf._virtual) for itf in self.interfaces if getattr(itf, "_virtual", None) is not None]
+        if not self.comm.allreduce(sum(len(v[0]) for _, v in virtual), op=MPI.SUM):
+            return None
+        rhs = b.copy()
+        for itf, (s, m, f) in virtual:
+            itf.band_used += 1
+            if len(s):
+                d = self._pair_dofs(itf, s, m).ravel().astype(PETSc.IntType)
+                free = d >= 0  # (a vector, unlike a matrix, does not skip negative indices)
+                rhs.setValues(d[free], -f.ravel()[free], addv=PETSc.InsertMode.ADD_VALUES)
+        rhs.assemblyBegin()
+        rhs.assemblyEnd()
+        return rhs
 
     def step_scale(self, dx: PETSc.Vec) -> float:
         """A factor ≤ 1 for the Newton correction ``dx`` that keeps every contact node's motion

@@ -325,7 +325,8 @@ def node_to_smooth_segment(x, side, offset, multiplier, penalty, area, with_tang
 
     x: (k, 10) current positions (x_s, x_p, x_a, x_b, x_q); side, offset, multiplier, penalty,
     area: (k,).
-    Returns g, ξ, p: (k,); f: (k, 10); K: (k, 10, 10); energy (k,). Pressure law, force and
+    Returns g, ξ, p: (k,); f: (k, 10); K: (k, 10, 10); energy (k,); N = ∂g/∂x (k, 10) of every
+    pair with a closest point (open ones included). Pressure law, force and
     tangent as :func:`node_to_segment` (f = −A p N, K = A(ε N Nᵀ − p ∂²g), ∂²g by complex step
     of N, the projection re-solved in complex arithmetic)."""
     k = x.shape[0]
@@ -336,6 +337,7 @@ def node_to_smooth_segment(x, side, offset, multiplier, penalty, area, with_tang
     f = np.zeros((k, 10))
     K = np.zeros((k, 10, 10))
     N = np.empty(10)
+    normal = np.zeros((k, 10))
     xc = np.empty(10, dtype=np.complex128)
     Nc = np.empty(10, dtype=np.complex128)
     for i in range(k):
@@ -347,6 +349,7 @@ def node_to_smooth_segment(x, side, offset, multiplier, penalty, area, with_tang
         gi = side[i] * _smooth_gap_gradient(x[i], N, xii) - offset[i]
         for r in range(10):
             N[r] *= side[i]
+            normal[i, r] = N[r]
         g[i] = gi
         eps = penalty[i]
         pi = multiplier[i] - eps * gi
@@ -376,4 +379,4 @@ def node_to_smooth_segment(x, side, offset, multiplier, penalty, area, with_tang
                 s = 0.5 * (K[i, r, c] + K[i, c, r])
                 K[i, r, c] = s
                 K[i, c, r] = s
-    return g, xi, p, f, K, energy
+    return g, xi, p, f, K, energy, normal

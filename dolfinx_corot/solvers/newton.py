@@ -122,11 +122,15 @@ def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions())
             # after a rise of the residual, the positive part of the contact tangents
             contact.project = it > 1 and report.residuals[-1] > report.residuals[-2]
         system.jacobian()
+        rhs = contact.newton_rhs(system.b) if contact is not None else None
         try:
-            report.increments.append(system.solve())
+            report.increments.append(system.solve(rhs))
         except np.linalg.LinAlgError as err:
             report.reason = str(err)
             break
+        finally:
+            if rhs is not None:
+                rhs.destroy()
         if contact is not None:
             scale = contact.step_scale(system.dx)  # contact nodes move at most a search margin
             if scale < 1.0:

@@ -525,6 +525,7 @@ class ContactSet:
         # the positive part of each pair's tangent (the curvature terms of a slave pressed on a
         # convex master can make an intermediate iterate's tangent indefinite)
         self.project = False
+        self.engaged = False
 
     def begin_newton(self) -> None:
         """A Newton solve starts: its first tangent is the exact one; each interface notes
@@ -539,12 +540,15 @@ class ContactSet:
         fint += contact forces."""
         t = time.perf_counter()
         self._blocks = []
+        self.engaged = False
         for itf in self.interfaces:
             dofs, f, K, pairs = itf.evaluate()
             self._blocks.append((dofs, K, pairs))
             fint.setValues(dofs.ravel().astype(PETSc.IntType), f.ravel(), addv=PETSc.InsertMode.ADD_VALUES)
         fint.assemblyBegin()
         fint.assemblyEnd()
+        # some pair is a candidate: the bodies are near each other (Newton's safeguards apply)
+        self.engaged = bool(self.comm.allreduce(sum(len(itf.candidates) for itf in self.interfaces), op=MPI.SUM))
         self.time += time.perf_counter() - t
 
     def _pair_dofs(self, itf, slaves, segments) -> np.ndarray:
@@ -592,7 +596,7 @@ class ContactSet:
             self.time += time.perf_counter() - t
 
     def _add_tangent(self, A: PETSc.Mat) -> None:
-        if not self.comm.allreduce(sum(len(itf.candidates) for itf in self.interfaces), op=MPI.SUM):
+        if not self.engaged:
             return
         if self.C is None or any(itf.pairs_changed for itf in self.interfaces):
             self._build_pattern(A)
@@ -634,6 +638,8 @@ class ContactSet:
         carry a node several segments along a surface comes from a tangent linearized far from
         there (e.g. indefinite at an intermediate iterate) and is shortened; the next
         iterations continue from the shorter step."""
+        if not self.engaged:
+            return 1.0
         start, stop = dx.getOwnershipRange()
         values = dx.getArray(readonly=True)
         worst = 0.0

@@ -41,8 +41,9 @@ class NewtonOptions:
     divergence_factor: ‖r‖ above this multiple of max(initial ‖r‖, reference force) is divergence;
     line_search: scale the correction so that the energy is nearly stationary along it
     (at most ``line_search_trials`` extra residual evaluations per iteration; a correction that
-    inverts an element is halved until the residual is finite); None (default): on for scenes with
-    contact, whose active set and closest points change within a step, off otherwise;
+    inverts an element is halved until the residual is finite); None (default): on while contact
+    interfaces have candidate pairs (their active set and closest points change within a step),
+    off otherwise;
     forcing: inexact Newton for iterative linear solvers (Eisenstat & Walker 1996, choice 2):
     the first solve of a step to ``forcing_initial``, then to
     η_k = γ (‖r_k‖/‖r_{k−1}‖)², kept below ``forcing_max`` and not below what the
@@ -97,9 +98,7 @@ def converged(norm: float, ref: float, report: NewtonReport, system, options: Ne
 def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions()) -> NewtonReport:
     """Iterate to equilibrium at ``load_factor``; returns a report (does not raise on divergence)."""
     report = NewtonReport(False, 0)
-    line_search = options.line_search
-    if line_search is None:
-        line_search = getattr(system, "contact", None) is not None
+    contact = getattr(system, "contact", None)
     system.begin_step()  # before the first residual: contact chooses its pairs afresh
     norm, ref = system.residual(load_factor)
     report.residuals.append(norm)
@@ -117,7 +116,6 @@ def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions())
                 eta = forcing_term(options, norm, report.residuals[-2] if it > 1 else None,
                                    eta if it > 1 else None, tol)
                 system.set_forcing(eta)
-        contact = getattr(system, "contact", None)
         if contact is not None:
             # after a rise of the residual, the positive part of the contact tangents
             contact.project = it > 1 and report.residuals[-1] > report.residuals[-2]
@@ -135,6 +133,9 @@ def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions())
             scale = contact.step_scale(system.dx)  # contact nodes move at most a search margin
             if scale < 1.0:
                 system.dx.scale(scale)
+        line_search = options.line_search
+        if line_search is None:  # near contact: the active set and closest points change
+            line_search = contact is not None and contact.engaged
         if line_search:
             norm, ref = _line_search(system, load_factor, options.line_search_trials,
                                      options.line_search_tolerance)

@@ -7,9 +7,11 @@ surfaces are small next to the bodies): reference coordinates, the global
 dofs of their nodes and the orientation of the master segments, whose
 body lies on the left of each segment. At each residual evaluation the
 current positions are gathered, the broad phase (bounding boxes inflated
-by a margin) gives the candidate pairs, the narrow phase picks for each
-slave the segment of its closest point, and the kernel
-(:mod:`.kernels2d`) gives forces and the consistent tangent.
+by a margin) gives the candidate pairs, each slave takes the segment of
+its closest point on the master surface — by default the C¹ Hermite curve
+through the master nodes, or the straight segments — and the kernels
+(:mod:`.kernels2d`) give forces and the consistent tangent. Beams are
+contact surfaces on either side of their axis, at half their depth.
 
 Each rank evaluates the slaves whose dofs it owns. Forces go into the
 internal-force vector, the tangent into a matrix C with a COO pattern over
@@ -176,9 +178,9 @@ def _tributary_lengths(X: np.ndarray, segments: np.ndarray) -> np.ndarray:
 
 def _smoothing_neighbours(X: np.ndarray, segments: np.ndarray, sharp: float) -> np.ndarray:
     """(m, 4) nodes (p, a, b, q) of each master segment a → b: p the node before a and q the node
-    after b along the surface, whose positions set the averaged normals at a and b; p = a (q = b)
-    at a free end, where more than two segments meet, or where the surface turns by more than
-    ``sharp`` radians (the segment's own normal there)."""
+    after b along the surface, whose positions set the smooth curve's tangents at a and b; p = a
+    (q = b) at a free end, where more than two segments meet, or where the surface turns by more
+    than ``sharp`` radians (a corner: the curve ends there without a neighbour)."""
     nodes = len(X)
     starts = np.bincount(segments[:, 0], minlength=nodes)
     ends = np.bincount(segments[:, 1], minlength=nodes)

@@ -19,15 +19,22 @@ def _two_blocks(n_low, n_up, ny=3):
                        "left": [("lower", "left"), ("upper", "left")]}, comm=comm)
 
 
-def _patch(n_low, n_up, law, symmetric, smooth=False):
+def _patch_scene(n_low, n_up, law, symmetric, smooth=False):
+    """The two blocks on rollers, a uniform pressure on the top, contact across y = 1."""
     tm = _two_blocks(n_low, n_up)
     sc = dc.Scene()
     b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
     sc.fix(b, "base", dofs=("uy",))
     sc.fix(b, "left", dofs=("ux",))
     sc.load(b, "top", traction=(0.0, -P))
-    sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), law=law, symmetric=symmetric, smooth=smooth)
+    made = sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), law=law, symmetric=symmetric,
+                      smooth=smooth)
     sc.monitor_reaction("base", b, "base")
+    return sc, made
+
+
+def _patch(n_low, n_up, law, symmetric, smooth=False):
+    sc, _ = _patch_scene(n_low, n_up, law, symmetric, smooth)
     res = dc.solve(sc, dc.LoadControl(steps=1))
     X, u = sc.model.nodes()  # rank 0: all nodes in a partition-independent order
     return sc, res, X, u
@@ -79,15 +86,7 @@ def test_one_pass_contact_fails_the_patch_test_as_known():
 def test_augmented_lagrangian_under_arc_length():
     """Arc-length steps with augmented-Lagrangian contact: after each converged step the Uzawa
     updates (at that load factor) drive the penetration below the tolerance; equilibrium holds."""
-    tm = _two_blocks(3, 4)
-    sc = dc.Scene()
-    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
-    sc.fix(b, "base", dofs=("uy",))
-    sc.fix(b, "left", dofs=("ux",))
-    sc.load(b, "top", traction=(0.0, -P))
-    (itf,) = sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"),
-                        law=dc.AugmentedLagrangian(gap_tolerance=1e-6), smooth=False)
-    sc.monitor_reaction("base", b, "base")
+    sc, (itf,) = _patch_scene(3, 4, dc.AugmentedLagrangian(gap_tolerance=1e-6), False)
     res = dc.solve(sc, dc.ArcLength(initial_increment=0.3, max_load_factor=1.0, max_steps=6))
     hist = res.history
     assert hist.column("uzawa_updates").min() >= 1
@@ -125,14 +124,7 @@ def test_assembled_contact_tangent_matches_finite_differences(symmetric, smooth)
     blocks (smooth master curves: the neighbouring master nodes enter each pair)."""
     from dolfinx_corot.assembly import make_system
 
-    tm = _two_blocks(3, 4)
-    sc = dc.Scene()
-    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
-    sc.fix(b, "base", dofs=("uy",))
-    sc.fix(b, "left", dofs=("ux",))
-    sc.load(b, "top", traction=(0.0, -P))
-    sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"),
-               law=dc.AugmentedLagrangian(), symmetric=symmetric, smooth=smooth)
+    sc, _ = _patch_scene(3, 4, dc.AugmentedLagrangian(), symmetric, smooth)
     for itf in sc.interfaces:
         itf.multiplier[:] = 0.3 * P  # an augmented state
     system = make_system(sc.model, contacts=sc.interfaces)

@@ -62,6 +62,36 @@ def _gap_gradient(x, out):
 
 
 @numba.njit(cache=True)
+def _pair_law(N, g, multiplier, eps, a, touch, with_tangent, f_row, K_row):
+    """Pressure ⟨λ − εg⟩ of one pair with gap g and gradient N: f_row = −A p N and, with the
+    tangent, K_row = A ε N Nᵀ (the curvature part is the caller's). Returns (p, energy, acting):
+    acting is False for an open pair (a touching one acts, with zero force)."""
+    pi = multiplier - eps * g
+    if pi < -eps * touch:
+        return 0.0, 0.0, False
+    pi = max(pi, 0.0)
+    n = N.shape[0]
+    for r in range(n):
+        f_row[r] = -a * pi * N[r]
+    if with_tangent:
+        for r in range(n):
+            for c in range(n):
+                K_row[r, c] = a * eps * N[r] * N[c]
+    return pi, 0.5 * a * pi * pi / eps, True
+
+
+@numba.njit(cache=True)
+def _symmetrize(K_row):
+    """∂²g is symmetric: remove the round-off asymmetry of its complex-step columns."""
+    n = K_row.shape[0]
+    for r in range(n):
+        for c in range(r + 1, n):
+            s = 0.5 * (K_row[r, c] + K_row[c, r])
+            K_row[r, c] = s
+            K_row[c, r] = s
+
+
+@numba.njit(cache=True)
 def gap(xs, x1, x2):
     """Gap g and projection coordinate ξ of slave points on segments.
 
@@ -104,21 +134,11 @@ def node_to_segment(xs, x1, x2, multiplier, penalty, area, with_tangent, touch=0
         x[2:4] = x1[i]
         x[4:6] = x2[i]
         g[i], xi[i] = _gap_gradient(x, N)
-        eps = penalty[i]
-        pi = multiplier[i] - eps * g[i]
-        if pi < -eps * touch:
-            continue  # open; a touching pair keeps its stiffness
-        pi = max(pi, 0.0)
-        p[i] = pi
-        a = area[i]
-        energy[i] = 0.5 * a * pi * pi / eps
-        for r in range(6):
-            f[i, r] = -a * pi * N[r]
-        if not with_tangent:
-            continue
-        for r in range(6):
-            for c in range(6):
-                K[i, r, c] = a * eps * N[r] * N[c]
+        p[i], energy[i], acting = _pair_law(N, g[i], multiplier[i], penalty[i], area[i], touch, with_tangent,
+                                            f[i], K[i])
+        if not (acting and with_tangent):
+            continue  # open (a touching pair keeps its stiffness)
+        a, pi = area[i], p[i]
         for c in range(6):
             for j in range(6):
                 xc[j] = x[j]
@@ -126,12 +146,7 @@ def node_to_segment(xs, x1, x2, multiplier, penalty, area, with_tangent, touch=0
             _gap_gradient(xc, Nc)
             for r in range(6):
                 K[i, r, c] -= a * pi * Nc[r].imag / _H
-        # ∂²g is symmetric; remove the round-off asymmetry
-        for r in range(6):
-            for c in range(r + 1, 6):
-                s = 0.5 * (K[i, r, c] + K[i, c, r])
-                K[i, r, c] = s
-                K[i, c, r] = s
+        _symmetrize(K[i])
     return g, xi, p, f, K, energy
 
 
@@ -351,21 +366,11 @@ def node_to_smooth_segment(x, side, offset, multiplier, penalty, area, with_tang
             N[r] *= side[i]
             normal[i, r] = N[r]
         g[i] = gi
-        eps = penalty[i]
-        pi = multiplier[i] - eps * gi
-        if pi < -eps * touch:
+        p[i], energy[i], acting = _pair_law(N, gi, multiplier[i], penalty[i], area[i], touch, with_tangent,
+                                            f[i], K[i])
+        if not (acting and with_tangent):
             continue
-        pi = max(pi, 0.0)
-        p[i] = pi
-        a = area[i]
-        energy[i] = 0.5 * a * pi * pi / eps
-        for r in range(10):
-            f[i, r] = -a * pi * N[r]
-        if not with_tangent:
-            continue
-        for r in range(10):
-            for c in range(10):
-                K[i, r, c] = a * eps * N[r] * N[c]
+        a, pi = area[i], p[i]
         for c in range(10):
             for j in range(10):
                 xc[j] = x[i, j]
@@ -374,9 +379,5 @@ def node_to_smooth_segment(x, side, offset, multiplier, penalty, area, with_tang
             _smooth_gap_gradient(xc, Nc, xic)
             for r in range(10):
                 K[i, r, c] -= a * pi * side[i] * Nc[r].imag / _H
-        for r in range(10):
-            for c in range(r + 1, 10):
-                s = 0.5 * (K[i, r, c] + K[i, c, r])
-                K[i, r, c] = s
-                K[i, c, r] = s
+        _symmetrize(K[i])
     return g, xi, p, f, K, energy, normal

@@ -13,16 +13,16 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
 
 from . import rotations  # noqa: E402
 from .amplitudes import Amplitude
-from .contact.interface import AugmentedLagrangian, ContactError, Penalty
+from .contact.laws import AugmentedLagrangian, ContactError, Penalty
 from .io.mesh import GroupNotFoundError, TaggedMesh, from_gmsh
 from .materials import Elastic, NeoHookean, SaintVenantKirchhoff
 from .result import History, Result
 from .scene import Scene
 from .sections import Circle, Rectangle, Section
-from .solvers import ArcLength, ConvergenceError, LoadControl, NewtonOptions, solve
+from .solvers import ArcLength, CheckpointError, ConvergenceError, LoadControl, NewtonOptions, solve
 
 __version__ = "0.1.0"
 
-__all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "ContactError", "Penalty", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
+__all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "Penalty", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
            "NeoHookean", "NewtonOptions", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
            "rotations", "solve"]

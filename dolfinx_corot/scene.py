@@ -21,10 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .continuum.solid import Solid
+from .contact.interface import Contact, Interface
+from .contact.laws import Penalty
 from .io.mesh import TaggedMesh
 from .materials import Elastic
-from .parts import Coupled, Frame2D, Frame3D, LineFrame, MembraneQuad, PartRef, Shell3D
+from .parts import Coupled, Part, PartRef, part_for_mesh
+from .parts.base import finite_vector
 from .sections import Section
 
 KINEMATICS = ("bernoulli", "timoshenko")
@@ -55,7 +57,7 @@ class Scene:
             raise ValueError(f"linear_solver '{linear_solver}' is not one of {self.LINEAR_SOLVERS}")
         self.linear_solver = linear_solver
         self.large_rotations = bool(large_rotations)
-        self._models: dict[int, LineFrame] = {}
+        self._models: dict[int, Part] = {}
         self._coupled: Coupled | None = None
         self.monitors: list[Monitor] = []
         self._loads = 0
@@ -63,7 +65,7 @@ class Scene:
         self.interfaces: list = []
 
     # -- parts -----------------------------------------------------------------
-    def _model(self, tmesh: TaggedMesh, solid_degree: int | None = None) -> LineFrame:
+    def _model(self, tmesh: TaggedMesh, solid_degree: int | None = None) -> Part:
         if not isinstance(tmesh, TaggedMesh):
             raise TypeError(f"expected a TaggedMesh from dolfinx_corot.io.from_gmsh, got {type(tmesh).__name__}")
         key = id(tmesh)
@@ -74,19 +76,9 @@ class Scene:
                     raise ValueError(f"parts of one scene live in one space: this mesh has gdim "
                                      f"{tmesh.mesh.geometry.dim}, the scene's other parts {sorted(gdims)}")
             self._coupled = None
-            if solid_degree is not None:
-                self._models[key] = Solid(tmesh, solid_degree, self.large_rotations)
-                return self._models[key]
-            if tmesh.mesh.topology.dim == tmesh.mesh.geometry.dim and tmesh.mesh.topology.dim > 1:
-                raise ValueError("this mesh fills its space (a continuum): use add_solid; structural parts need "
-                                 "lines or surfaces in space")
-            if tmesh.mesh.topology.dim == 2:
-                frame = MembraneQuad if tmesh.mesh.topology.cell_name() == "quadrilateral" else Shell3D
-            else:
-                frame = Frame3D if tmesh.mesh.geometry.dim == 3 else Frame2D
-            self._models[key] = frame(tmesh, self.large_rotations)
+            self._models[key] = part_for_mesh(tmesh, self.large_rotations, solid_degree)
         model = self._models[key]
-        if (solid_degree is not None) != isinstance(model, Solid):
+        if (solid_degree is not None) != model.continuum:
             raise ValueError("a mesh carries either a solid or structural parts, not both")
         if solid_degree is not None and model.degree != solid_degree:
             raise ValueError(f"the solid on this mesh has degree {model.degree}; all its regions share it")
@@ -118,21 +110,11 @@ class Scene:
         """
         if kinematics not in KINEMATICS:
             raise ValueError(f"kinematics '{kinematics}' is not one of {KINEMATICS}")
-        if not isinstance(material, Elastic):
-            raise TypeError(f"beam '{where}': material must be dc.Elastic, got {type(material).__name__}")
+        self._check_material("beam", where, material)
         model = self._model(tmesh)
-        if isinstance(model, Shell3D):
-            raise ValueError(f"beam '{where}': beams need a mesh of lines; this mesh has triangles "
-                             "(for beams on shells read the lines as a mesh of their own: from_gmsh(model, 3, dim=1))")
-        E, G = material.E, material.G
         if kinematics == "timoshenko" and section.As <= 0.0:
             raise ValueError(f"beam '{where}': Timoshenko kinematics needs a shear area As > 0")
-        GAs = G * section.As if kinematics == "timoshenko" else 0.0
-        if isinstance(model, Frame2D):
-            return model.add_beam(where, E * section.A, E * section.I, GAs, 0.0, "beam")
-        return model.add_beam(where, {"EA": E * section.A, "GJ": G * section.torsion_constant,
-                                      "EIy": E * section.second_moment_y, "EIz": E * section.I,
-                                      "GAy": GAs, "GAz": GAs}, orientation, 0.0, "beam")
+        return model.add_beam(where, section, material, kinematics, orientation)
 
     def add_shell(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float, material: Elastic,
                   membrane: str = "opt", drilling: float = 1e-2) -> PartRef:
@@ -143,29 +125,17 @@ class Scene:
         rotations carry real stiffness and which bends in its plane without locking; or
         ``"cst"``, the constant-strain triangle with a drilling penalty α·G·t·A, α = ``drilling``.
         """
-        if not isinstance(material, Elastic):
-            raise TypeError(f"shell '{where}': material must be dc.Elastic, got {type(material).__name__}")
-        model = self._model(tmesh)
-        if isinstance(model, MembraneQuad):
-            raise NotImplementedError(f"shell '{where}': shells are triangles; this mesh has quadrilaterals, which "
-                                      "carry membranes (add_membrane). Mesh the shell with triangles "
-                                      "(gmsh: Mesh.RecombineAll = 0)")
-        if not isinstance(model, Shell3D):
-            raise ValueError(f"shell '{where}': shells need a triangle mesh in 3D (from_gmsh(model, gdim=3))")
-        return model.add_shell(where, material.E, material.nu, float(thickness), float(drilling), membrane)
+        self._check_material("shell", where, material)
+        return self._model(tmesh).add_shell(where, material.E, material.nu, float(thickness), float(drilling),
+                                            membrane)
 
     def add_membrane(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float,
                      material: Elastic) -> PartRef:
         """Co-rotational membranes (in-plane stiffness only) on group ``where`` of a triangle
         (constant-strain triangles) or quadrilateral (bilinear Q4) mesh in space; nodes
         carried by membranes alone have their rotations fixed."""
-        if not isinstance(material, Elastic):
-            raise TypeError(f"membrane '{where}': material must be dc.Elastic, got {type(material).__name__}")
-        model = self._model(tmesh)
-        if not isinstance(model, (Shell3D, MembraneQuad)):
-            raise ValueError(f"membrane '{where}': membranes need a triangle or quadrilateral mesh in 3D "
-                             "(from_gmsh(model, gdim=3))")
-        return model.add_membrane(where, material.E, material.nu, float(thickness))
+        self._check_material("membrane", where, material)
+        return self._model(tmesh).add_membrane(where, material.E, material.nu, float(thickness))
 
     def add_truss(self, tmesh: TaggedMesh, where: str | None = None, *, area: float, material: Elastic,
                   prestress_force: float = 0.0) -> PartRef:
@@ -173,21 +143,15 @@ class Scene:
 
         prestress_force: initial axial force N0 (tension positive).
         """
-        if not isinstance(material, Elastic):
-            raise TypeError(f"truss '{where}': material must be dc.Elastic, got {type(material).__name__}")
+        self._check_material("truss", where, material)
         if not area > 0.0:
             raise ValueError(f"truss '{where}': area = {area} must be positive")
-        model = self._model(tmesh)
-        if isinstance(model, Shell3D):
-            raise ValueError(f"truss '{where}': bars need a mesh of lines; this mesh has triangles")
-        if isinstance(model, Frame2D):
-            return model.add_beam(where, material.E * area, 0.0, 0.0, float(prestress_force), "truss")
-        _, d = model._element_vectors(tmesh.cells(where))
-        # any vector not parallel to the bars orients their (unused) local axes
-        v = np.array([0.0, 0.0, 1.0]) if np.all(np.abs(d[:, 2]) < 0.9 * np.linalg.norm(d, axis=1)) \
-            else np.array([1.0, 0.0, 0.0])
-        return model.add_beam(where, {"EA": material.E * area, "GJ": 0.0, "EIy": 0.0, "EIz": 0.0, "GAy": 0.0,
-                                      "GAz": 0.0}, v, float(prestress_force), "truss")
+        return self._model(tmesh).add_truss(where, area, material, prestress_force)
+
+    @staticmethod
+    def _check_material(kind: str, where, material) -> None:
+        if not isinstance(material, Elastic):
+            raise TypeError(f"{kind} '{where}': material must be dc.Elastic, got {type(material).__name__}")
 
     # -- conditions ------------------------------------------------------------
     def fix(self, part: PartRef, where: str, dofs: tuple[str, ...] | None = None) -> None:
@@ -226,44 +190,23 @@ class Scene:
         moment (mx, my, mz), a fixed spatial vector. Solids: ``traction`` (per unit
         reference area, a facet group) or ``force`` at each node of the group.
         """
-        g = part.model.gdim
-        if isinstance(part.model, Solid):
-            if moment is not None:
-                raise ValueError(f"load '{where}': solids carry no moments")
-            for name, value in (("force", force), ("traction", traction)):
-                if value is None:
-                    continue
-                value = np.atleast_1d(np.asarray(value, dtype=float))
-                if value.shape != (g,) or not np.all(np.isfinite(value)):
-                    raise ValueError(f"load '{where}': {name} must be {g} finite numbers, got {value.tolist()}")
-                if name == "force":
-                    part.model.add_load(where, value, amplitude)
-                else:
-                    part.model.add_traction(where, value, amplitude)
-                self._loads += 1
-            return
+        model = part.model
         if traction is not None:
-            raise ValueError(f"load '{where}': tractions act on solids; structures take forces and moments")
-        nm = 1 if g == 2 else 3
-        force = np.zeros(g) if force is None else np.atleast_1d(np.asarray(force, dtype=float))
-        moment = np.zeros(nm) if moment is None else np.atleast_1d(np.asarray(moment, dtype=float))
-        if force.shape != (g,) or moment.shape != (nm,) or not (np.all(np.isfinite(force))
-                                                             and np.all(np.isfinite(moment))):
-            raise ValueError(f"load '{where}': in {g}D give force as {g} finite numbers and moment as "
-                             f"{'a number' if nm == 1 else '3 numbers'}; got force={force.tolist()}, "
-                             f"moment={moment.tolist()}")
-        part.model.add_load(where, np.concatenate([force, moment]), amplitude)
-        self._loads += 1
+            model.add_traction(where, finite_vector(f"load '{where}'", "traction", traction, model.gdim), amplitude)
+            self._loads += 1
+        values = model.load_values(where, force, moment)
+        if values is not None:
+            model.add_load(where, values, amplitude)
+            self._loads += 1
 
     def gravity(self, part: PartRef, acceleration, density: float, where: str | None = None,
                 amplitude=None) -> None:
         """Body force ρ·g per unit reference volume on a solid (cells of ``where``, all if None)."""
-        if not isinstance(part.model, Solid):
-            raise ValueError("gravity acts on solids (structural self-weight: point loads)")
+        model = part.model
         acc = np.atleast_1d(np.asarray(acceleration, dtype=float))
-        if acc.shape != (part.model.gdim,) or not (np.isfinite(density) and density >= 0.0):
-            raise ValueError(f"gravity: acceleration must be {part.model.gdim} numbers and density ≥ 0")
-        part.model.add_body_force(where, density * acc, amplitude)
+        if acc.shape != (model.gdim,) or not (np.isfinite(density) and density >= 0.0):
+            raise ValueError(f"gravity: acceleration must be {model.gdim} numbers and density ≥ 0")
+        model.add_body_force(where, density * acc, amplitude)
         self._loads += 1
 
     def contact(self, slaves: tuple[PartRef, str], masters: tuple[PartRef, str], law=None,
@@ -278,8 +221,6 @@ class Scene:
         from segment to segment: robust sliding over curved and deforming masters); False: the
         straight segments (slave forces shared linearly by the segment's two nodes: the patch
         test is passed exactly). Returns the interfaces made."""
-        from .contact.interface import Interface, Penalty
-
         law = Penalty() if law is None else law
         made = [Interface(slaves, masters, law, smooth)]
         if symmetric:
@@ -303,8 +244,8 @@ class Scene:
 
     # -- introspection -----------------------------------------------------------
     @property
-    def model(self) -> LineFrame | Coupled:
-        """The structural model: one mesh's, or the parts of several meshes coupled."""
+    def model(self) -> Part | Coupled:
+        """The part model: one mesh's, or the parts of several meshes coupled."""
         if not self._models:
             raise ValueError("the scene has no parts: add a beam or a truss first")
         if len(self._models) == 1:
@@ -313,28 +254,31 @@ class Scene:
             self._coupled = Coupled(list(self._models.values()))
         return self._coupled
 
+    def contributions(self) -> list:
+        """The contributions the scene adds to its parts' system (contact, when it has interfaces):
+        a scene without them pays nothing for them."""
+        return [Contact(self.interfaces)] if self.interfaces else []
+
     def effects(self) -> list[str]:
         """What will be assembled, in words."""
-        out = []
-        for m in self._models.values():
-            if isinstance(m, Solid):
-                law = m.law.__name__ if self.large_rotations else "small-strain elastic"
-                kind = "plane strain" if m.gdim == 2 else "3D"
-                out.append(f"continuum ({law}, {kind}, degree {m.degree} on {m.tmesh.mesh.topology.cell_name()}s)")
-                continue
-            kinds = sorted({p.kind for p in m.parts})
-            frame = "co-rotational" if self.large_rotations else "geometrically linear"
-            out.append(f"{' and '.join(kinds)} elements ({frame}, {m.gdim}D)")
+        out = [m.effect() for m in self._models.values()]
         if self._loads:
             out.append("dead loads")
         if self._prescribed:
             out.append("prescribed displacements")
         for itf in self.interfaces:
+            d = itf.describe()
             kind = "augmented Lagrangian" if itf.law.augmented else "penalty"
             surface = "smooth master curve" if itf.smooth else "straight master segments"
-            out.append(f"contact {itf.name}: {len(itf.area)} slave nodes on {len(itf.master['segments'])} "
+            out.append(f"contact {itf.name}: {d['slave_nodes']} slave nodes on {d['master_segments']} "
                        f"segments ({kind}, penalty {itf.penalty:.3g}, {surface})")
         return out
+
+    def describe(self) -> dict:
+        """What defines the scene (its fingerprint's content): parts with mesh sizes, a hash of the
+        node coordinates, groups and materials; the contact interfaces."""
+        return {"large_rotations": self.large_rotations, "parts": [m.describe() for m in self._models.values()],
+                "interfaces": [itf.describe() for itf in self.interfaces]}
 
     def monitor_values(self, system) -> dict[str, float]:
         """Monitored dofs and reactions at the current state (``system`` holds f_int)."""

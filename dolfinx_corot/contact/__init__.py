@@ -1,1 +1,5 @@
-"""Node-to-segment contact: search, kernels, interfaces."""
+"""Node-to-segment contact: search, kernels, laws, interfaces (a contribution of the system)."""
+from .interface import Contact, Interface
+from .laws import AugmentedLagrangian, ContactError, Penalty
+
+__all__ = ["AugmentedLagrangian", "Contact", "ContactError", "Interface", "Penalty"]

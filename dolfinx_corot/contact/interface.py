@@ -19,152 +19,24 @@ all candidate pairs (entries on constrained dofs are left out), added to
 the system matrix. The pattern is rebuilt only when the candidate set
 grows (a slave moves more than half the margin since the last search).
 
-Laws (Wriggers 2006, §6.2 and §10.3; Simo & Laursen 1992):
-
-* :class:`Penalty` — pressure p = ε⟨−g⟩ with ε in pressure per unit
-  penetration; by default ε = ``factor`` · E*/h with E* the smallest
-  plane-strain modulus E/(1−ν²) of the two bodies and h the mean master
-  segment length.
-* :class:`AugmentedLagrangian` — p = ⟨λ − ε g⟩; after each converged
-  Newton solve λ ← ⟨λ − ε g⟩ (Uzawa) until the largest penetration is below
-  ``gap_tolerance`` · h; multipliers are carried over to the next step.
+The laws are in :mod:`.laws`. :class:`Contact` is the interfaces of a scene as one
+:class:`~dolfinx_corot.assembly.contribution.Contribution` of the system: its Newton
+hooks are the safeguards near contact and the Uzawa updates, its state the
+multipliers and the candidate pairs.
 """
 from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
-
 import numpy as np
 from mpi4py import MPI
-from petsc4py import PETSc
 
+from ..assembly.contribution import Contribution
 from .kernels2d import node_to_smooth_segment, node_to_vertex, smooth_gap
+from .laws import ContactError, Penalty
 from .search import broad_phase, narrow_phase
 
 logger = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class Penalty:
-    """Penalty contact. penalty: ε in pressure per unit penetration (None: ``factor`` · E*/h)."""
-
-    penalty: float | None = None
-    factor: float = 10.0
-
-    augmented = False
-
-
-@dataclass(frozen=True)
-class AugmentedLagrangian(Penalty):
-    """Penalty plus Uzawa updates of the contact pressure until the largest penetration is below
-    ``gap_tolerance`` times the mean master segment length (at most ``max_updates`` per step)."""
-
-    gap_tolerance: float = 1e-3
-    max_updates: int = 10
-
-    augmented = True
-
-
-class ContactError(ValueError):
-    """A contact surface that cannot be built (missing group, unsupported part)."""
-
-
-def boundary_surface(part, where: str) -> dict:
-    """Nodes and oriented segments of the facet group ``where`` of a 2D solid part, on every rank.
-
-    Returns {"key": (n,) global node keys, "X": (n, 2) reference coordinates, "local": (n_own,)
-    positions of this rank's owned nodes in the arrays, "ldofs": (n_own, 2) their local unrolled dofs
-    in the model, "segments": (m, 2) node indices with the body on the left}."""
-    model = part.model
-    from ..continuum.solid import Solid
-    from ..parts import Frame2D
-
-    if isinstance(model, Frame2D):
-        return _beam_surface(model, where)
-    if not isinstance(model, Solid) or model.gdim != 2:
-        raise ContactError(f"contact surface '{where}': only 2D solids and 2D beams are supported so far "
-                           f"(got a {type(model).__name__} in {model.gdim}D)")
-    if model.degree != 1:
-        raise ContactError(f"contact surface '{where}': node-to-segment contact needs linear solids "
-                           f"(degree 1); this solid has degree {model.degree}")
-    tm = model.tmesh
-    facets = tm.facets(where)
-    if facets is None:
-        raise ContactError(f"contact surface '{where}' is not a group of boundary lines of the solid mesh "
-                           f"(groups: {sorted(tm.groups)})")
-    mesh = tm.mesh
-    tdim = 2
-    mesh.topology.create_connectivity(1, tdim)
-    mesh.topology.create_connectivity(1, 0)
-    f2c = mesh.topology.connectivity(1, tdim)
-    f2v = mesh.topology.connectivity(1, 0)
-    c2v = mesh.topology.connectivity(tdim, 0)
-    n_owned_cells = mesh.topology.index_map(tdim).size_local
-    V = model.V
-    Xdof = V.tabulate_dof_coordinates()[:, :2]
-    seg_blocks, inner = [], 0
-    for f in facets:
-        cells = f2c.links(f)
-        if len(cells) != 1:
-            inner += 1
-            continue
-        c = cells[0]
-        if c >= n_owned_cells:
-            continue  # the owner of the cell adds this facet
-        cv = list(c2v.links(c))
-        cd = V.dofmap.cell_dofs(c)
-        a, b = (cd[cv.index(v)] for v in f2v.links(f))
-        centroid = Xdof[cd].mean(axis=0)
-        t = Xdof[b] - Xdof[a]
-        n = np.array([t[1], -t[0]])
-        if np.dot(0.5 * (Xdof[a] + Xdof[b]) - centroid, n) < 0.0:
-            a, b = b, a  # the body on the left of a -> b
-        seg_blocks.append((a, b))
-    if model.comm.allreduce(inner, op=MPI.SUM):  # raised on every rank
-        raise ContactError(f"contact surface '{where}': some of its lines lie inside the solid, "
-                           "not on its boundary")
-    return _gather_surface(model, np.array(seg_blocks, dtype=np.int64).reshape(-1, 2), Xdof, where)
-
-
-def _gather_surface(model, seg_blocks: np.ndarray, Xdof: np.ndarray, where: str) -> dict:
-    """The arrays of :func:`boundary_surface` from this rank's segments (local dof blocks)."""
-    V = model.V
-    bs = V.dofmap.index_map_bs
-    imap = V.dofmap.index_map
-    gblocks = imap.local_to_global(np.arange(imap.size_local + imap.num_ghosts, dtype=np.int32))
-    comm = model.comm
-    seg_keys = np.concatenate(comm.allgather(gblocks[seg_blocks].reshape(-1, 2)))
-    if len(seg_keys) == 0:
-        raise ContactError(f"contact surface '{where}' has no segments")
-    keys, segments = np.unique(seg_keys, return_inverse=True)
-    segments = segments.reshape(-1, 2)
-    X = np.zeros((len(keys), 2))
-    own_blocks = np.flatnonzero(np.isin(gblocks[: imap.size_local], keys))
-    own_pos = np.searchsorted(keys, gblocks[own_blocks])
-    for pos, x in zip(comm.allgather(own_pos), comm.allgather(Xdof[own_blocks])):
-        X[pos] = x
-    ldofs = (own_blocks[:, None] * bs + np.arange(2)[None, :]).astype(np.int32)
-    return {"keys": keys, "X": X, "local": own_pos, "ldofs": ldofs, "segments": segments, "model": model}
-
-
-def _beam_surface(model, where: str) -> dict:
-    """Nodes and segments (the elements) of the line group ``where`` of a 2D beam part: the beam's
-    axis offset by half the section's depth on either side is the contact surface; its nodes may
-    be slaves or its elements masters (their translations take the force)."""
-    tm = model.tmesh
-    cells = tm.cells(where)
-    n_owned = tm.mesh.topology.index_map(1).size_local
-    cells = cells[cells < n_owned]
-    seg_blocks = np.array([model.V.dofmap.cell_dofs(c) for c in cells], dtype=np.int64).reshape(-1, 2)
-    surf = _gather_surface(model, seg_blocks, model.V.tabulate_dof_coordinates()[:, :2], where)
-    surf["beam"] = True
-    # half the depth of each element's section: √(12 EI/EA)/2 (exact for rectangles; 0 for bars)
-    props = model.props.x.array.reshape(-1, model.nprops)[model._prop_blocks[cells]]
-    EA, EI = props[:, 0], props[:, 1]
-    half = 0.5 * np.sqrt(12.0 * EI / np.where(EA > 0.0, EA, 1.0)) * (EA > 0.0)
-    surf["half_thickness"] = np.concatenate(model.comm.allgather(half))
-    return surf
 
 
 def _tributary_lengths(X: np.ndarray, segments: np.ndarray) -> np.ndarray:
@@ -216,34 +88,27 @@ class Interface:
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = True):
         if not isinstance(law, Penalty):
             raise TypeError(f"contact law must be dc.Penalty or dc.AugmentedLagrangian, got {type(law).__name__}")
+        if slaves[0].model is masters[0].model and slaves[1] == masters[1]:
+            raise ContactError(f"contact of surface '{slaves[1]}' with itself is not supported: give two "
+                               "surfaces (self-contact is not implemented)")
         self.slave_spec, self.master_spec, self.law = slaves, masters, law
-        self.slave = boundary_surface(*slaves)
-        self.master = boundary_surface(*masters)
+        self.slave = slaves[0].model.surface(slaves[1])
+        self.master = masters[0].model.surface(masters[1])
         self.name = f"{slaves[1]} -> {masters[1]}"
         # slaves: all nodes of the slave group; their tributary lengths on the slave boundary
-        self.area = _tributary_lengths(self.slave["X"], self.slave["segments"])
-        Xm, sm = self.master["X"], self.master["segments"]
+        self.area = _tributary_lengths(self.slave.X, self.slave.facets)
+        Xm, sm = self.master.X, self.master.facets
         # beams: contact on either side of the axis, at half the section's depth from it
-        self.two_sided = bool(self.master.get("beam"))
-        self.master_offset = self.master.get("half_thickness", np.zeros(len(sm)))
-        self.slave_offset = np.zeros(len(self.area))
-        if self.slave.get("beam"):
-            ss = self.slave["segments"]
-            np.maximum.at(self.slave_offset, ss[:, 0], self.slave["half_thickness"])
-            np.maximum.at(self.slave_offset, ss[:, 1], self.slave["half_thickness"])
+        self.two_sided = self.master.two_sided
+        self.master_offset = self.master.offsets
+        self.slave_offset = self.slave.node_offsets()
         self.h = float(np.mean(np.linalg.norm(Xm[sm[:, 1]] - Xm[sm[:, 0]], axis=1)))
         if law.penalty is not None:
             if not law.penalty > 0.0:
                 raise ValueError(f"contact '{self.name}': the penalty must be positive, got {law.penalty}")
             self.penalty = float(law.penalty)
         else:
-            moduli = []
-            for surf in (self.slave, self.master):
-                if surf.get("beam"):
-                    continue  # the solid's modulus sets the scale
-                m = surf["model"]
-                E, nu = m.E.x.array, m.nu.x.array
-                moduli.append(m.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN))
+            moduli = [surf.modulus for surf in (self.slave, self.master) if surf.modulus is not None]
             if not moduli:
                 raise ContactError(f"contact '{self.name}': between two beams the penalty has no solid to scale "
                                    "with: give it, e.g. dc.Penalty(penalty=...)")
@@ -261,19 +126,13 @@ class Interface:
     # -- binding to a system ---------------------------------------------------------
     def bind(self, system) -> None:
         """Global dofs of both surfaces in ``system``'s numbering; the dofs it constrains."""
-        for surf in (self.slave, self.master):
-            comm = surf["model"].comm
-            g = system.global_dofs(surf["model"], surf["ldofs"].ravel()).reshape(-1, 2)
-            gd = np.zeros((len(surf["keys"]), 2), dtype=np.int64)
-            for pos, vals in zip(comm.allgather(surf["local"]), comm.allgather(g)):
-                gd[pos] = vals
-            surf["gdofs"] = gd
-        self.comm = self.slave["model"].comm
+        self.comm = self.slave.part.comm
+        self.slave_gdofs, self.master_gdofs = (self._global_dofs(surf, system) for surf in (self.slave, self.master))
         self.constrained = system.constrained_global_dofs()
         n = len(self.area)
         # each rank evaluates the slaves whose x dof it owns
         start, stop = system.ownership_range()
-        self.mine = np.flatnonzero((self.slave["gdofs"][:, 0] >= start) & (self.slave["gdofs"][:, 0] < stop))
+        self.mine = np.flatnonzero((self.slave_gdofs[:, 0] >= start) & (self.slave_gdofs[:, 0] < stop))
         self.candidates = np.zeros((0, 2), dtype=np.int64)
         self.anchor = None  # slave and master positions at the last search
         self.pairs_changed = True
@@ -283,19 +142,23 @@ class Interface:
         self.had_contact = False
         self.band_used = 0
 
+    def _global_dofs(self, surf, system) -> np.ndarray:
+        """(n, gdim) global dofs of the surface's nodes' translations in ``system``, on every rank."""
+        g = system.global_dofs(surf.part, surf.local_dofs().ravel()).reshape(-1, surf.gdim)
+        gd = np.zeros((len(surf.keys), surf.gdim), dtype=np.int64)
+        for pos, vals in zip(self.comm.allgather(surf.local), self.comm.allgather(g)):
+            gd[pos] = vals
+        return gd
+
     def _positions(self, surf) -> np.ndarray:
-        u = surf["model"].state.x.array[surf["ldofs"]]
-        x = surf["X"].copy()
-        for pos, vals in zip(self.comm.allgather(surf["local"]), self.comm.allgather(u)):
-            x[pos] += vals
-        return x
+        return surf.positions(self.comm)
 
     def _search(self, xs, xm) -> None:
         moved = np.inf if self.anchor is None else max(
             np.abs(xs - self.anchor[0]).max(initial=0.0), np.abs(xm - self.anchor[1]).max(initial=0.0))
         if moved <= 0.5 * self.margin:
             return
-        seg = self.master["segments"]
+        seg = self.master.facets
         # beams: the surfaces lie up to half their depth from the axes the search sees
         reach = self.margin + self.slave_offset.max(initial=0.0) + self.master_offset.max(initial=0.0)
         pairs = broad_phase(xs[self.mine], xm[seg[:, 0]], xm[seg[:, 1]], reach)
@@ -314,7 +177,7 @@ class Interface:
         pairs in contact (p > 0)."""
         xs, xm = self._positions(self.slave), self._positions(self.master)
         self._search(xs, xm)
-        seg = self.master["segments"]
+        seg = self.master.facets
         mine_pairs = self.candidates
         self.active[:] = -1
         # (a rank without candidates goes on as well: the steps below agree across ranks)
@@ -342,7 +205,7 @@ class Interface:
         # contact alone would have no stiffness there: then the pairs within a tenth of a segment
         # count as closed for the next correction — penalty stiffness in the tangent, and their
         # penalty force at the current gap (a pull, in the correction's right-hand side only, see
-        # ContactSet.newton_rhs); the residual keeps the contact law. At most BAND_USES corrections
+        # Contact.correction_rhs); the residual keeps the contact law. At most BAND_USES corrections
         # per Newton solve: bodies that really separate (held otherwise) are then left to do so
         self._virtual = None
         for attempt in range(2):
@@ -356,8 +219,8 @@ class Interface:
                 break
             touch = 0.1 * self.h
         keep = (lam - self.penalty * g) >= -self.penalty * touch  # closed or touching
-        gd = self.master["gdofs"]
-        dofs = np.hstack([self.slave["gdofs"][s]] + [gd[ext[:, j]] for j in range(4)])
+        gd = self.master_gdofs
+        dofs = np.hstack([self.slave_gdofs[s]] + [gd[ext[:, j]] for j in range(4)])
         if touch > self.touch:
             pull = keep & (lam - self.penalty * g < 0.0)
             self._virtual = (s[pull], m[pull],
@@ -423,7 +286,7 @@ class Interface:
         # vertex shared by two segments (outside a convex corner) within the search margin
         rest = pairs[segment[pairs[:, 0]] < 0]
         if len(rest):
-            seg = self.master["segments"]
+            seg = self.master.facets
             near, t = narrow_phase(xs, xm[seg[:, 0]], xm[seg[:, 1]], rest)
             end = np.where(t < 0.0, 0, 1)
             m = np.maximum(near, 0)
@@ -438,7 +301,7 @@ class Interface:
 
     def _vertex_normals(self, xm: np.ndarray) -> np.ndarray:
         """Unit averaged outward normals (n_master, 2) of the master nodes (current)."""
-        seg = self.master["segments"]
+        seg = self.master.facets
         t = xm[seg[:, 1]] - xm[seg[:, 0]]
         n = np.column_stack([t[:, 1], -t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
         out = np.zeros_like(xm)
@@ -446,6 +309,12 @@ class Interface:
         np.add.at(out, seg[:, 1], n)
         norm = np.linalg.norm(out, axis=1)
         return out / np.where(norm > 0.0, norm, 1.0)[:, None]
+
+    def describe(self) -> dict:
+        """What defines the interface (for the scene's fingerprint and ``Scene.effects``)."""
+        return {"slaves": self.slave_spec[1], "masters": self.master_spec[1], "law": repr(self.law),
+                "smooth": self.smooth, "penalty": self.penalty, "slave_nodes": len(self.area),
+                "master_segments": len(self.master.facets)}
 
     def gaps(self) -> tuple[np.ndarray, np.ndarray]:
         """(slave indices, gaps) of this rank's slaves that have a master segment now."""
@@ -483,22 +352,22 @@ class Interface:
         out = np.zeros_like(p)
         self.comm.Allreduce(p, out, op=MPI.SUM)
         if not current:
-            return self.slave["X"], out
+            return self.slave.X, out
         x = self._positions(self.slave)
-        return x, out * self.area / _tributary_lengths(x, self.slave["segments"])
+        return x, out * self.area / _tributary_lengths(x, self.slave.facets)
 
     def master_pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Contact pressure on the master side: the contact forces on each master node over its
         tributary length (n_master,), with the nodes' coordinates (n_master, 2), on every rank."""
         s, m, f = self._forces
-        seg = self.master["segments"]
-        force = np.zeros((len(self.master["X"]), 2))
+        seg = self.master.facets
+        force = np.zeros((len(self.master.X), 2))
         for j in range(4):
             np.add.at(force, self.ext[m, j], f[:, 2 * j + 2:2 * j + 4])
         total = np.zeros_like(force)
         self.comm.Allreduce(force, total, op=MPI.SUM)
-        length = _tributary_lengths(self.master["X"], seg)
-        x = self._positions(self.master) if current else self.master["X"]
+        length = _tributary_lengths(self.master.X, seg)
+        x = self._positions(self.master) if current else self.master.X
         return x, np.linalg.norm(total, axis=1) / length
 
 
@@ -508,146 +377,117 @@ def _positive_part(K: np.ndarray) -> np.ndarray:
     return np.einsum("kij,kj,klj->kil", vec, np.maximum(lam, 0.0), vec)
 
 
-class ContactSet:
-    """The interfaces of a scene bound to one system: adds their forces to f_int and their
-    tangent to the system matrix through a matrix over the candidate pairs."""
+class Contact(Contribution):
+    """The contact interfaces of a scene as one contribution of the system.
 
+    Residual: every interface evaluated at the current configuration (search,
+    pairs, kernels); tangent: the pairs' blocks over the candidate pairs, whose
+    10 × 10 dof blocks are the declared couplings. Newton hooks: a Newton solve's
+    first tangent is exact; after a rise of the residual the next tangent keeps
+    the positive part of each pair's tangent; corrections are capped so that no
+    contact node moves more than its interface's search margin; the line search
+    is asked for while any pair is a candidate; lifted pairs of bodies that were
+    touching may count as closed for a few corrections (:meth:`correction_rhs`);
+    after convergence, Uzawa updates of augmented-Lagrangian multipliers.
+    State: the multipliers (and, for files, the candidate pairs and the positions
+    of the last search).
+    """
 
-    def __init__(self, interfaces, system):
+    name = "contact"
+
+    def __init__(self, interfaces):
         self.interfaces = list(interfaces)
-        for itf in self.interfaces:
-            itf.bind(system)
-        self.comm = system.comm
-        self.C: PETSc.Mat | None = None
-        self._merged = False
-        self._blocks = []
-        self.pattern_builds = 0
-        self.time = 0.0  # s spent in contact search, kernels and assembly
         # Newton sets this after an iteration that raised the residual: the next tangent keeps only
         # the positive part of each pair's tangent (the curvature terms of a slave pressed on a
         # convex master can make an intermediate iterate's tangent indefinite)
         self.project = False
-        self.engaged = False
+        self._engaged = False
+        self._blocks = []
 
-    def begin_newton(self) -> None:
-        """A Newton solve starts: its first tangent is the exact one; each interface notes
-        whether its bodies touch at the start."""
+    def bind(self, system) -> None:
+        for itf in self.interfaces:
+            itf.bind(system)
+        self.comm = system.comm
+
+    # -- couplings and assembly ---------------------------------------------------------
+    @property
+    def couplings_changed(self) -> bool:
+        return any(itf.pairs_changed for itf in self.interfaces)
+
+    @couplings_changed.setter
+    def couplings_changed(self, value: bool) -> None:
+        for itf in self.interfaces:
+            itf.pairs_changed = bool(value)
+
+    def couplings(self) -> np.ndarray:
+        """The 10 dofs (slave, p, a, b, q) of every candidate pair of this rank."""
+        blocks = [_pair_dofs(itf, itf.candidates[:, 0], itf.candidates[:, 1]) for itf in self.interfaces]
+        return np.concatenate(blocks) if blocks else np.zeros((0, 10), dtype=np.int64)
+
+    def engaged(self) -> bool:
+        return any(len(itf.candidates) for itf in self.interfaces)
+
+    def add_residual(self, add) -> None:
+        self._blocks = []
+        for itf in self.interfaces:
+            dofs, f, K, pairs = itf.evaluate()
+            self._blocks.append((K, pairs))
+            add(dofs, f)
+        # some pair is a candidate: the bodies are near each other (Newton's safeguards apply)
+        self._engaged = bool(self.comm.allreduce(sum(len(itf.candidates) for itf in self.interfaces), op=MPI.SUM))
+
+    def add_tangent(self, add) -> None:
+        for itf, (K, (s, m)) in zip(self.interfaces, self._blocks):
+            if len(s):
+                add(_pair_dofs(itf, s, m), _positive_part(K) if self.project else K)
+
+    # -- Newton hooks -----------------------------------------------------------------
+    def before_step(self) -> None:
+        for itf in self.interfaces:
+            itf.uzawa_updates = 0
+
+    def before_solve(self) -> None:
+        """A Newton solve starts: its first tangent is the exact one; each interface notes whether
+        its bodies touch at the start."""
         self.project = False
         for itf in self.interfaces:
             itf.first_evaluation = True
             itf.band_used = 0
 
-    def add_force(self, fint: PETSc.Vec) -> None:
-        """Evaluate every interface at the current configuration (search, pairs, kernels);
-        fint += contact forces."""
-        t = time.perf_counter()
-        self._blocks = []
-        self.engaged = False
-        for itf in self.interfaces:
-            dofs, f, K, pairs = itf.evaluate()
-            self._blocks.append((dofs, K, pairs))
-            fint.setValues(dofs.ravel().astype(PETSc.IntType), f.ravel(), addv=PETSc.InsertMode.ADD_VALUES)
-        fint.assemblyBegin()
-        fint.assemblyEnd()
-        # some pair is a candidate: the bodies are near each other (Newton's safeguards apply)
-        self.engaged = bool(self.comm.allreduce(sum(len(itf.candidates) for itf in self.interfaces), op=MPI.SUM))
-        self.time += time.perf_counter() - t
+    def after_iteration(self, residuals) -> None:
+        self.project = len(residuals) > 1 and residuals[-1] > residuals[-2]
 
-    def _pair_dofs(self, itf, slaves, segments) -> np.ndarray:
-        """Global dofs (k, 10) of slave–segment pairs (slave, p, a, b, q), −1 on constrained dofs
-        (PETSc skips them)."""
-        ext, gd = itf.ext[segments], itf.master["gdofs"]
-        dofs = np.hstack([itf.slave["gdofs"][slaves]] + [gd[ext[:, j]] for j in range(4)])
-        dofs[np.isin(dofs, itf.constrained)] = -1
-        return dofs
+    def needs_line_search(self) -> bool:
+        return self._engaged
 
-    def _build_pattern(self, A: PETSc.Mat) -> None:
-        """C's pattern: the 10 × 10 blocks of every candidate pair of every rank, row by row."""
-        rows, cols = [], []
-        for itf in self.interfaces:
-            c = itf.candidates
-            dofs = self._pair_dofs(itf, c[:, 0], c[:, 1])
-            rows.append(np.repeat(dofs, 10, axis=1).ravel())
-            cols.append(np.tile(dofs, (1, 10)).ravel())
-        r, q = np.concatenate(rows), np.concatenate(cols)
-        keep = (r >= 0) & (q >= 0)
-        entries = np.unique(np.stack([r[keep], q[keep]], axis=1), axis=0)
-        entries = np.unique(np.concatenate(self.comm.allgather(entries)), axis=0)
-        start, stop = A.getOwnershipRange()
-        mine = entries[(entries[:, 0] >= start) & (entries[:, 0] < stop)]
-        indptr = np.searchsorted(mine[:, 0], np.arange(start, stop + 1)).astype(PETSc.IntType)
-        if self.C is not None:
-            self.C.destroy()
-        self.C = PETSc.Mat().create(comm=self.comm)
-        self.C.setSizes(A.getSizes())
-        self.C.setType("aij")
-        self.C.setPreallocationCSR((indptr, mine[:, 1].astype(PETSc.IntType)))
-        self.C.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
-        self._merged = False
-        self.pattern_builds += 1
-        for itf in self.interfaces:
-            itf.pairs_changed = False
-
-    def add_tangent(self, A: PETSc.Mat) -> None:
-        """A += C, the tangent of the contact forces of the last :meth:`add_force` (nothing while
-        no rank has a candidate pair: bodies far apart cost a search, no matrix work)."""
-        t = time.perf_counter()
-        try:
-            self._add_tangent(A)
-        finally:
-            self.time += time.perf_counter() - t
-
-    def _add_tangent(self, A: PETSc.Mat) -> None:
-        if not self.engaged:
-            return
-        if self.C is None or any(itf.pairs_changed for itf in self.interfaces):
-            self._build_pattern(A)
-        self.C.zeroEntries()
-        for itf, (dofs, K, (s, m)) in zip(self.interfaces, self._blocks):
-            if len(s):
-                d = self._pair_dofs(itf, s, m).astype(PETSc.IntType)
-                if self.project:
-                    K = _positive_part(K)
-                self.C.setValuesRCV(d, d, K, addv=PETSc.InsertMode.ADD_VALUES)
-        self.C.assemble()
-        lgmap = A.getLGMap()
-        A.axpy(1.0, self.C, PETSc.Mat.Structure.SUBSET if self._merged else PETSc.Mat.Structure.DIFFERENT)
-        if not self._merged:
-            A.setLGMap(*lgmap)  # a new pattern replaces the matrix's internals
-            self._merged = True
-
-    def newton_rhs(self, b: PETSc.Vec) -> PETSc.Vec | None:
-        """The right-hand side of the next Newton correction when an interface predicts pairs
-        that are open now to be closed (see :meth:`Interface.evaluate`): b minus their penalty
-        forces at the current gaps, a new vector; None (use b) otherwise."""
+    def correction_rhs(self):
+        """When an interface predicts pairs that are open now to be closed (see
+        :meth:`Interface.evaluate`): their penalty forces at the current gaps, to be taken out of
+        the next correction's right-hand side; None otherwise (all ranks agree)."""
         virtual = [(itf, itf._virtual) for itf in self.interfaces if getattr(itf, "_virtual", None) is not None]
         if not self.comm.allreduce(sum(len(v[0]) for _, v in virtual), op=MPI.SUM):
             return None
-        rhs = b.copy()
+        dofs, forces = [np.zeros((0, 10), dtype=np.int64)], [np.zeros((0, 10))]
         for itf, (s, m, f) in virtual:
             itf.band_used += 1
             if len(s):
-                d = self._pair_dofs(itf, s, m).ravel().astype(PETSc.IntType)
-                free = d >= 0  # (a vector, unlike a matrix, does not skip negative indices)
-                rhs.setValues(d[free], -f.ravel()[free], addv=PETSc.InsertMode.ADD_VALUES)
-        rhs.assemblyBegin()
-        rhs.assemblyEnd()
-        return rhs
+                dofs.append(_pair_dofs(itf, s, m))
+                forces.append(f)
+        return np.concatenate(dofs), np.concatenate(forces)
 
-    def step_scale(self, dx: PETSc.Vec) -> float:
+    def limit_correction(self, dx) -> float:
         """A factor ≤ 1 for the Newton correction ``dx`` that keeps every contact node's motion
         within its interface's search margin (half a master segment): a correction that would
         carry a node several segments along a surface comes from a tangent linearized far from
         there (e.g. indefinite at an intermediate iterate) and is shortened; the next
         iterations continue from the shorter step."""
-        if not self.engaged:
+        if not self._engaged:
             return 1.0
         start, stop = dx.getOwnershipRange()
         values = dx.getArray(readonly=True)
         worst = 0.0
         for itf in self.interfaces:
-            for surf in (itf.slave, itf.master):
-                gd = surf["gdofs"]
+            for gd in (itf.slave_gdofs, itf.master_gdofs):
                 own = ((gd >= start) & (gd < stop)).all(axis=1)
                 if own.any():
                     d = values[gd[own] - start]
@@ -655,22 +495,54 @@ class ContactSet:
         worst = self.comm.allreduce(worst, op=MPI.MAX)
         return 1.0 if worst <= 1.0 else 1.0 / worst
 
-    def augment(self) -> bool:
+    def on_converged(self) -> bool:
         """One Uzawa update on every augmented interface that needs it; True if any changed."""
         changed = [itf.augment() for itf in self.interfaces]
         return any(changed)
 
-    def begin_step(self) -> None:
-        for itf in self.interfaces:
-            itf.uzawa_updates = 0
+    def history(self, report) -> dict:
+        return {"uzawa_updates": report.updates}
 
+    # -- state ------------------------------------------------------------------------
     def checkpoint(self):
         return [itf.multiplier.copy() for itf in self.interfaces]
 
-    def restore(self, cp) -> None:
-        for itf, lam in zip(self.interfaces, cp):
+    def restore(self, state) -> None:
+        for itf, lam in zip(self.interfaces, state):
             itf.multiplier[:] = lam
 
-    def destroy(self) -> None:
-        if self.C is not None:
-            self.C.destroy()
+    def state_arrays(self) -> dict:
+        """Multipliers, candidate pairs (all ranks') and the positions of the last search."""
+        out = {}
+        for k, itf in enumerate(self.interfaces):
+            out[f"{k}_multiplier"] = itf.multiplier.copy()
+            cand = np.concatenate(self.comm.allgather(itf.candidates)).reshape(-1, 2)
+            out[f"{k}_candidates"] = np.unique(cand, axis=0)
+            if itf.anchor is not None:
+                out[f"{k}_anchor_slave"], out[f"{k}_anchor_master"] = itf.anchor
+        return out
+
+    def set_state_arrays(self, arrays: dict) -> None:
+        for k, itf in enumerate(self.interfaces):
+            lam = arrays[f"{k}_multiplier"]
+            if lam.shape != itf.multiplier.shape:
+                raise ValueError(f"contact '{itf.name}': the checkpoint holds {len(lam)} slave nodes, the "
+                                 f"interface has {len(itf.multiplier)}")
+            itf.multiplier[:] = lam
+            cand = arrays[f"{k}_candidates"].astype(np.int64).reshape(-1, 2)
+            itf.candidates = cand[np.isin(cand[:, 0], itf.mine)]
+            itf.pairs_changed = True
+            if f"{k}_anchor_slave" in arrays:
+                itf.anchor = (arrays[f"{k}_anchor_slave"].copy(), arrays[f"{k}_anchor_master"].copy())
+
+    def describe(self) -> dict:
+        return {"name": self.name, "interfaces": [itf.describe() for itf in self.interfaces]}
+
+
+def _pair_dofs(itf, slaves, segments) -> np.ndarray:
+    """Global dofs (k, 10) of slave–segment pairs (slave, p, a, b, q), −1 on constrained dofs
+    (PETSc skips them in matrices)."""
+    ext, gd = itf.ext[segments], itf.master_gdofs
+    dofs = np.hstack([itf.slave_gdofs[slaves]] + [gd[ext[:, j]] for j in range(4)])
+    dofs[np.isin(dofs, itf.constrained)] = -1
+    return dofs

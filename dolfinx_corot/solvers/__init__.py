@@ -1,5 +1,8 @@
-"""Newton's method and the drivers that follow a load path."""
-from .drivers import ArcLength, LoadControl, solve
-from .newton import ConvergenceError, NewtonOptions, NewtonReport, newton
+"""Newton's method (one loop with hooks for every driver), the drivers that follow a load path,
+and runs with history, checkpoints and restart."""
+from .control import ArcLength, LoadControl
+from .newton import ConvergenceError, NewtonOptions, NewtonReport, Stepper, newton, solve_step
+from .run import CheckpointError, solve
 
-__all__ = ["ArcLength", "ConvergenceError", "LoadControl", "NewtonOptions", "NewtonReport", "newton", "solve"]
+__all__ = ["ArcLength", "CheckpointError", "ConvergenceError", "LoadControl", "NewtonOptions", "NewtonReport",
+           "Stepper", "newton", "solve", "solve_step"]

@@ -75,7 +75,8 @@ class NewtonReport:
     residuals: list[float] = field(default_factory=list)
     increments: list[float] = field(default_factory=list)
     reason: str = ""
-    uzawa: int = 0  # augmented-Lagrangian updates (contact)
+    updates: int = 0  # contributions' state updates after convergence (augmented-Lagrangian: Uzawa)
+    load_factor: float = math.nan  # where the solve ended
 
     def rate(self) -> float:
         """Estimated order of convergence from the last three residuals (nan if too few)."""
@@ -88,68 +89,91 @@ class NewtonReport:
         return math.log(c / b) / math.log(b / a)
 
 
-def converged(norm: float, ref: float, report: NewtonReport, system, options: NewtonOptions) -> bool:
-    """Residual test, or a last correction below xtol of the step's summed corrections."""
-    if norm <= options.rtol * ref + options.atol:
-        return True
-    return bool(report.increments) and report.increments[-1] <= options.xtol * system.step_increment_norm()
+class Stepper:
+    """How a Newton correction is made at a fixed load factor (load and displacement control):
+    K dx = rhs. Arc-length supplies its own (:class:`~dolfinx_corot.solvers.control.ArcLengthStepper`),
+    which also moves the load factor; the Newton loop and its hooks are the same."""
+
+    check_growth = True  # a residual that grows ``max_growth`` times running is divergence
+
+    def __init__(self, load_factor: float):
+        self.load_factor = load_factor
+
+    def correct(self, system, rhs) -> float:
+        """Set ``system.dx`` to the correction; return its norm (raises LinAlgError)."""
+        return system.solve(rhs)
+
+    def scale(self, factor: float) -> None:
+        """The correction was scaled by ``factor`` (a contribution's limit)."""
+
+    def trial_load_factor(self, s: float) -> float:
+        """The load factor after applying s·dx (line search)."""
+        return self.load_factor
+
+    def accept(self, system, s: float) -> None:
+        """s·dx was applied."""
 
 
-def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions()) -> NewtonReport:
-    """Iterate to equilibrium at ``load_factor``; returns a report (does not raise on divergence)."""
+def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin: bool = True) -> NewtonReport:
+    """Iterate to equilibrium at ``load_factor`` (a number, or a :class:`Stepper` that makes the
+    corrections); returns a report (does not raise on divergence).
+
+    The system's contributions take part through hooks: ``before_solve`` before the first
+    residual, ``correction_rhs`` for the right-hand side of each correction, ``limit_correction``
+    to shorten it, ``needs_line_search`` (when ``options.line_search`` is None) and
+    ``after_iteration``. begin: start the solve here (False: the driver did, before a predictor).
+    """
+    stepper = load_factor if isinstance(load_factor, Stepper) else Stepper(load_factor)
     report = NewtonReport(False, 0)
-    contact = getattr(system, "contact", None)
-    system.begin_step()  # before the first residual: contact chooses its pairs afresh
-    norm, ref = system.residual(load_factor)
+    if begin:
+        system.begin_step()  # before the first residual: contributions' before_solve hooks
+    norm, ref = system.residual(stepper.load_factor)
     report.residuals.append(norm)
     scale = max(norm, ref)
     growth = 0
     small_correction = False
+    eta = None
     for it in range(1, options.max_iterations + 1):
         tol = options.rtol * ref + options.atol
         if norm <= tol or small_correction:
             report.converged = True
             break
-        if getattr(system, "iterative", False):
+        if system.iterative:
             system.reuse_preconditioner(options.preconditioner == "step" and it > 1)
             if options.forcing:
                 eta = forcing_term(options, norm, report.residuals[-2] if it > 1 else None,
                                    eta if it > 1 else None, tol)
                 system.set_forcing(eta)
-        if contact is not None:
-            # after a rise of the residual, the positive part of the contact tangents
-            contact.project = it > 1 and report.residuals[-1] > report.residuals[-2]
         system.jacobian()
-        rhs = contact.newton_rhs(system.b) if contact is not None else None
         try:
-            report.increments.append(system.solve(rhs))
+            report.increments.append(stepper.correct(system, system.correction_rhs()))
         except np.linalg.LinAlgError as err:
             report.reason = str(err)
             break
-        finally:
-            if rhs is not None:
-                rhs.destroy()
-        if contact is not None:
-            scale = contact.step_scale(system.dx)  # contact nodes move at most a search margin
-            if scale < 1.0:
-                system.dx.scale(scale)
+        factor = system.limit_correction()  # e.g. contact nodes move at most a search margin
+        if factor < 1.0:
+            system.dx.scale(factor)
+            stepper.scale(factor)
         line_search = options.line_search
-        if line_search is None:  # near contact: the active set and closest points change
-            line_search = contact is not None and contact.engaged
+        if line_search is None:  # on while a contribution asks for it (near contact)
+            line_search = system.needs_line_search()
         if line_search:
-            norm, ref = _line_search(system, load_factor, options.line_search_trials,
-                                     options.line_search_tolerance)
+            s, norm, ref = _line_search(system, stepper, options.line_search_trials, options.line_search_tolerance)
         else:
+            s = 1.0
             system.update()
-            norm, ref = system.residual(load_factor)
+            norm, ref = system.residual(stepper.trial_load_factor(1.0))
+        stepper.accept(system, s)
         report.iterations = it
         small_correction = report.increments[-1] <= options.xtol * system.step_increment_norm()
         report.residuals.append(norm)
+        system.after_iteration(report.residuals)
         logger.debug("  Newton %2d: |r| = %.3e  |dx| = %.3e", it, norm, report.increments[-1])
         # the first corrections of a large-rotation step may raise |r| (a linear predictor
         # stretches rotating elements); divergence is growth three times running, or blow-up
         growth = growth + 1 if norm > report.residuals[-2] else 0
-        if not math.isfinite(norm) or growth >= options.max_growth or norm > options.divergence_factor * scale:
+        if not math.isfinite(norm) or (stepper.check_growth and (growth >= options.max_growth
+                                                                 or norm > options.divergence_factor * scale)):
             report.reason = (f"diverged: |r| = {norm:.3e} after {it} iterations "
                              f"(initial {report.residuals[0]:.3e})")
             break
@@ -159,9 +183,26 @@ def newton(system, load_factor: float, options: NewtonOptions = NewtonOptions())
         if not report.converged:
             report.reason = (f"no convergence in {options.max_iterations} iterations: |r| = {norm:.3e} "
                              f"> tolerance {tol:.3e}")
-    if getattr(system, "iterative", False):
+    if system.iterative:
         system.set_forcing(None)
         system.reuse_preconditioner(False)
+    report.load_factor = stepper.load_factor
+    return report
+
+
+def solve_step(system, stepper, options: NewtonOptions, begin: bool = True) -> NewtonReport:
+    """Newton to equilibrium, then, while a contribution updates its state after convergence
+    (augmented-Lagrangian multipliers: Uzawa), Newton again at the converged load factor. The
+    report sums the iterations; ``updates`` counts the updates."""
+    report = newton(system, stepper, options, begin)
+    while report.converged and system.on_converged():
+        again = newton(system, report.load_factor, options)
+        again.updates = report.updates + 1
+        again.iterations += report.iterations
+        again.residuals = report.residuals + again.residuals
+        report = again
+    if not report.converged and report.updates:
+        report.reason = f"after {report.updates} contribution update(s): {report.reason}"
     return report
 
 
@@ -182,20 +223,20 @@ def forcing_term(options: NewtonOptions, norm: float, previous: float | None, et
     return float(min(max(eta, 1e-12), options.forcing_max))
 
 
-def _line_search(system, load_factor: float, trials: int, tolerance: float) -> tuple[float, float]:
-    """Apply s·dx with s from a secant search on g(s) = dx·r; returns the new (‖r‖, ref)."""
+def _line_search(system, stepper: Stepper, trials: int, tolerance: float) -> tuple[float, float, float]:
+    """Apply s·dx with s from a secant search on g(s) = dx·r; returns (s, ‖r‖, ref) after it."""
     g0 = system.directional_residual()
     base = system.checkpoint()
     s = 1.0
     system.update(s)
-    norm, ref = system.residual(load_factor)
+    norm, ref = system.residual(stepper.trial_load_factor(s))
     while not math.isfinite(norm) and s > 1.0 / 64:
         s *= 0.5  # the full correction inverts an element: back off
         system.restore(base)
         system.update(s)
-        norm, ref = system.residual(load_factor)
+        norm, ref = system.residual(stepper.trial_load_factor(s))
     if not (g0 > 0.0) or s < 1.0:
-        return norm, ref
+        return s, norm, ref
     g = system.directional_residual()
     best = (abs(g), 1.0, norm, ref)
     for _ in range(trials):
@@ -208,7 +249,7 @@ def _line_search(system, load_factor: float, trials: int, tolerance: float) -> t
         s = s_new
         system.restore(base)
         system.update(s)
-        norm, ref = system.residual(load_factor)
+        norm, ref = system.residual(stepper.trial_load_factor(s))
         g = system.directional_residual()
         if abs(g) < best[0]:
             best = (abs(g), s, norm, ref)
@@ -216,5 +257,5 @@ def _line_search(system, load_factor: float, trials: int, tolerance: float) -> t
         s, norm, ref = best[1], best[2], best[3]
         system.restore(base)
         system.update(s)
-        norm, ref = system.residual(load_factor)
-    return norm, ref
+        norm, ref = system.residual(stepper.trial_load_factor(s))
+    return s, norm, ref

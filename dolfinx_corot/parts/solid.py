@@ -12,8 +12,13 @@ with P the first Piola–Kirchhoff stress of the law (``continuum.laws``), or
 the small-strain stress when the scene has ``large_rotations=False``.
 External loads are dead: tractions per reference area on facet groups,
 body forces per reference volume, point forces at nodes. It presents the
-same model protocol to :class:`dolfinx_corot.assembly.System` as the
-structural parts.
+same part protocol (:class:`dolfinx_corot.parts.base.Part`) as the structural
+parts.
+
+Reference configuration: the forms integrate over the reference positions
+X' = X + w, with X the mesh and w a displacement field the solid owns
+(:meth:`Solid.capture_reference`; zero at creation): ∇_{X'} u = ∇_X u (I + ∇_X w)⁻¹
+and dX' = det(I + ∇_X w) dX. While w = 0 the forms are those on the mesh itself.
 """
 from __future__ import annotations
 
@@ -26,19 +31,22 @@ import dolfinx.fem
 import dolfinx.fem.petsc
 import dolfinx.la
 
+from ..continuum.kinematics import deformation_gradient
+from ..continuum.laws import first_piola, lame
 from ..io.mesh import TaggedMesh
-from ..parts import PartRef, PrescribedMotion
 from ..materials import Elastic
-from .kinematics import deformation_gradient
-from .laws import first_piola, lame
+from .base import Part, PartRef, finite_vector
+from .surface import Surface, SurfaceError, gather_surface
 
 CELLS = ("triangle", "quadrilateral", "tetrahedron", "hexahedron")
 
 
-class Solid(PrescribedMotion):
+class Solid(Part):
     """A large-deformation continuum on one mesh (see the module docstring)."""
 
     symmetric_tangent = True  # hyperelastic, dead loads
+    continuum = True
+    kind_name = "solid"
 
     def __init__(self, tmesh: TaggedMesh, degree: int, large_rotations: bool):
         mesh = tmesh.mesh
@@ -54,12 +62,14 @@ class Solid(PrescribedMotion):
         self.large_rotations = bool(large_rotations)
         self.gdim = self.tdim = mesh.geometry.dim
         self.dof_names = ("ux", "uy", "uz")[: self.gdim]
-        self.ndof = self.translations = self.gdim
+        self.translations = self.state_size = self.gdim
         # Gauss rule: 2p on simplices, 2p + 1 on quadrilaterals/hexahedra ((p + 1)^d points)
         self.quadrature = 2 * degree + (0 if cell in ("triangle", "tetrahedron") else 1)
         self.V = dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", degree))
         self.nodes_per_cell = self.V.dofmap.dof_layout.num_dofs  # dof blocks per cell
         self.state = dolfinx.fem.Function(self.V, name="displacement")
+        self.reference_shift = dolfinx.fem.Function(self.V, name="reference_shift")
+        self._shifted = False
         Q = dolfinx.fem.FunctionSpace(mesh, ("DG", 0))
         self.E = dolfinx.fem.Function(Q, name="E")
         self.nu = dolfinx.fem.Function(Q, name="nu")
@@ -67,19 +77,10 @@ class Solid(PrescribedMotion):
         cmap = mesh.topology.index_map(self.tdim)
         self._owner_of_cell = np.full(cmap.size_local + cmap.num_ghosts, "", dtype=object)
         self.law: type | None = None
-        self.parts: list = []
-        self._bcs: list[tuple[np.ndarray, tuple[int, ...]]] = []
-        self._prescribed: list[tuple[np.ndarray, int, float, object]] = []
-        self._prescribed_values: list = []
+        self._regions: list[tuple[str, str, float, float]] = []
         self._tractions: list[tuple[str, np.ndarray, object]] = []
         self._body: list[tuple[str | None, np.ndarray, object]] = []
-        self._point_loads: list[tuple[np.ndarray, np.ndarray, object]] = []
-        self._forms = None
-        self.lifting_bcs: list = []
-
-    @property
-    def comm(self):
-        return self.V.mesh.comm
+        self._init_conditions()
 
     # -- building -------------------------------------------------------------
     def add_region(self, where: str | None, material: Elastic):
@@ -100,8 +101,12 @@ class Solid(PrescribedMotion):
         self.law = kind
         ref = PartRef(self, where or "", "solid")
         self.parts.append(ref)
+        self._regions.append((label, kind.__name__, float(material.E), float(material.nu)))
         self._forms = None
         return ref
+
+    def _materials(self) -> list:
+        return self._regions
 
     def _entities(self, where: str) -> tuple[int, np.ndarray]:
         """(dim, local entities) that locate the dofs of group ``where``: its facets when it is a
@@ -114,20 +119,6 @@ class Solid(PrescribedMotion):
                              "boundary dofs by facets; read the mesh with from_gmsh")
         return 0, self.tmesh.vertices(where)
 
-    def _dof_blocks(self, where: str) -> np.ndarray:
-        """Local blocks (nodes of V, owned and ghost) of group ``where``."""
-        return dolfinx.fem.locate_dofs_topological(self.V, *self._entities(where))
-
-    def fix(self, where: str, dofs: tuple[int, ...]) -> None:
-        self._bcs.append((self._dof_blocks(where), dofs))
-
-    def prescribe(self, where: str, comp: int, value: float, amplitude=None) -> None:
-        self._prescribed.append((where, comp, float(value), amplitude))
-
-    def add_load(self, where: str, values: np.ndarray, amplitude=None) -> None:
-        """Point forces at every node of group ``where`` (values: gdim components)."""
-        self._point_loads.append((self._dof_blocks(where), np.asarray(values, dtype=float)[: self.gdim], amplitude))
-
     def add_traction(self, where: str, traction: np.ndarray, amplitude=None) -> None:
         if self.tmesh.facets(where) is None:
             raise ValueError(f"traction on '{where}': a group of facets (dimension {self.tdim - 1}) read with "
@@ -139,22 +130,50 @@ class Solid(PrescribedMotion):
             self.tmesh.cells(where)  # fails early for a missing group
         self._body.append((where, np.asarray(force, dtype=float), amplitude))
 
-    @property
-    def amplitudes(self) -> list:
-        out = []
-        for *_, amp in self._tractions + self._body + self._point_loads:
-            if amp is not None and amp not in out:
-                out.append(amp)
-        return out
+    def _load_amplitudes(self) -> list:
+        return [amp for *_, amp in self._tractions + self._body + self._point_loads]
+
+    def load_values(self, where: str, force, moment) -> np.ndarray:
+        if moment is not None:
+            raise ValueError(f"load '{where}': solids carry no moments")
+        return None if force is None else finite_vector(f"load '{where}'", "force", force, self.gdim)
+
+    def effect(self) -> str:
+        law = self.law.__name__ if self.large_rotations else "small-strain elastic"
+        kind = "plane strain" if self.gdim == 2 else "3D"
+        return f"continuum ({law}, {kind}, degree {self.degree} on {self.tmesh.mesh.topology.cell_name()}s)"
+
+    # -- reference configuration -------------------------------------------------------
+    def capture_reference(self, shift: np.ndarray | None = None) -> None:
+        """Take the mesh moved by ``shift`` (local array of V, owned and ghost; None: the current
+        displacement) as the stress-free reference of the elements, and zero the displacement.
+        At creation the reference is the mesh itself."""
+        if not hasattr(self, "reference_shift"):  # the base's call at creation: the mesh
+            return Part.capture_reference(self)
+        values = self.state.x.array if shift is None else np.asarray(shift)
+        self.reference_shift.x.array[:] += values
+        self.state.x.array[:] = 0.0
+        self._shifted = bool(self.comm.allreduce(bool(np.any(self.reference_shift.x.array != 0.0))))
+        self.reference = self.V.tabulate_dof_coordinates()[:, : self.gdim] + \
+            self.reference_shift.x.array.reshape(-1, self.gdim)
+        self._forms = None
 
     # -- forms -----------------------------------------------------------------
+    def _gradient(self, u):
+        """∇u with respect to the reference positions."""
+        if not self._shifted:
+            return ufl.grad(u)
+        return ufl.dot(ufl.grad(u), ufl.inv(ufl.Identity(self.gdim) + ufl.grad(self.reference_shift)))
+
     def stress(self, u):
         """First Piola–Kirchhoff stress (large rotations) or small-strain stress of u."""
         lmbda, mu = lame(self.E, self.nu)
+        grad = self._gradient(u)
         if not self.large_rotations:
-            eps = ufl.sym(ufl.grad(u))
+            eps = ufl.sym(grad)
             return lmbda * ufl.tr(eps) * ufl.Identity(self.gdim) + 2.0 * mu * eps
-        return first_piola(self.law, deformation_gradient(u), lmbda, mu)
+        F = ufl.Identity(self.gdim) + grad if self._shifted else deformation_gradient(u)
+        return first_piola(self.law, F, lmbda, mu)
 
     def _check_complete(self) -> None:
         cmap = self.tmesh.mesh.topology.index_map(self.tdim)
@@ -169,7 +188,10 @@ class Solid(PrescribedMotion):
         if self._forms is None:
             self._check_complete()
             u, v, du = self.state, ufl.TestFunction(self.V), ufl.TrialFunction(self.V)
-            residual = ufl.inner(self.stress(u), ufl.grad(v)) * ufl.dx(metadata={"quadrature_degree": self.quadrature})
+            dx = ufl.dx(metadata={"quadrature_degree": self.quadrature})
+            if self._shifted:
+                dx = ufl.det(ufl.Identity(self.gdim) + ufl.grad(self.reference_shift)) * dx
+            residual = ufl.inner(self.stress(u), self._gradient(v)) * dx
             jacobian = ufl.derivative(residual, u, du)
             self._forms = (dolfinx.fem.form(residual), dolfinx.fem.form(jacobian))
         return self._forms
@@ -193,57 +215,25 @@ class Solid(PrescribedMotion):
             return None
         return dolfinx.fem.form(sum(terms[1:], terms[0]))
 
-    def external_force(self, b: PETSc.Vec, amplitude=None) -> None:
-        """Add the dead loads of one amplitude (None: proportional to λ) at unit factor."""
+    def _add_distributed_loads(self, b: PETSc.Vec, amplitude) -> None:
+        """Add the tractions and body forces of one amplitude (None: proportional to λ) at unit factor."""
         form = self._load_form(amplitude)
         if form is not None:
-            tmp = b.duplicate()
-            with tmp.localForm() as t:
-                t.set(0.0)
-            dolfinx.fem.petsc.assemble_vector(tmp, form)
-            tmp.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-            b.axpy(1.0, tmp)
-            tmp.destroy()
-        n_owned = self.V.dofmap.index_map.size_local
-        with b.localForm() as bl:
-            arr = bl.array.reshape(-1, self.ndof)
-            for blocks, values, amp in self._point_loads:
-                if amp is amplitude:
-                    arr[blocks[blocks < n_owned]] += values
-
-    # -- constraints -------------------------------------------------------------
-    def dirichlet_bcs(self) -> list:
-        zero = PETSc.ScalarType(0.0)
-        bcs = []
-        for blocks, comps in self._bcs:
-            for comp in comps:
-                bcs.append(dolfinx.fem.dirichletbc(zero, blocks * self.ndof + comp, self.V.sub(comp)))
-        self._prescribed_values = []
-        self.lifting_bcs = []
-        for where, comp, value, amplitude in self._prescribed:
-            Vi, _ = self.V.sub(comp).collapse()
-            g = dolfinx.fem.Function(Vi)
-            dofs = dolfinx.fem.locate_dofs_topological((self.V.sub(comp), Vi), *self._entities(where))
-            bc = dolfinx.fem.dirichletbc(g, dofs, self.V.sub(comp))
-            bcs.append(bc)
-            self.lifting_bcs.append(bc)
-            self._prescribed_values.append((g, dofs[1], value, amplitude))
-        return bcs
-
-    def constraint_dofs(self) -> list:
-        out = [(blocks * self.ndof + comp, 0.0, None) for blocks, comps in self._bcs for comp in comps]
-        out += [(self._dof_blocks(where) * self.ndof + comp, value, amp) for where, comp, value, amp in self._prescribed]
-        return out
+            vec = dolfinx.fem.assemble_vector(form)
+            vec.scatter_reverse(dolfinx.la.ScatterMode.add)
+            n = self.V.dofmap.index_map.size_local * self.ndof
+            with b.localForm() as bl:
+                bl.array[:n] += vec.array[:n]
 
     def bending_blocks(self) -> np.ndarray:
         return np.zeros(self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts, dtype=bool)
 
     # -- linear solver -------------------------------------------------------------
-    def near_nullspace(self) -> PETSc.NullSpace:
-        """Rigid-body modes (3 in 2D, 6 in 3D) of V, for algebraic multigrid."""
-        x = self.V.tabulate_dof_coordinates()
+    def near_nullspace_modes(self) -> list[np.ndarray]:
+        """Rigid-body modes (3 in 2D, 6 in 3D) on the owned blocks of V ((n_owned, gdim) each), the
+        near-nullspace of algebraic multigrid."""
         n_owned = self.V.dofmap.index_map.size_local
-        x = x[:n_owned]
+        x = self.V.tabulate_dof_coordinates()[:n_owned]
         d = self.gdim
         modes = []
         for k in range(d):
@@ -256,13 +246,7 @@ class Solid(PrescribedMotion):
             m[:, i] = -x[:, j]
             m[:, j] = x[:, i]
             modes.append(m)
-        vecs = []
-        for m in modes:
-            vec = dolfinx.la.create_petsc_vector(self.V.dofmap.index_map, d)
-            vec.array[:] = m.ravel()
-            vecs.append(vec)
-        dolfinx.la.orthonormalize(vecs)
-        return PETSc.NullSpace().create(vectors=vecs, comm=self.comm)
+        return modes
 
     # -- state ---------------------------------------------------------------------
     def update(self, dx: PETSc.Vec) -> None:
@@ -275,25 +259,15 @@ class Solid(PrescribedMotion):
     def displacement_vector(self) -> PETSc.Vec:
         return self.state.vector
 
-    def _input_ids(self) -> np.ndarray:
+    def node_keys(self) -> np.ndarray:
         """A key per local dof block (owned and ghost) for :class:`~dolfinx_corot.assembly.DofLayout`:
         the input (gmsh) node number on linear meshes, so that structures read from the same gmsh
         model share the solid's nodes; quadratic solids number their blocks apart (never shared)."""
+        if self.degree == 1:
+            return super().node_keys()
         imap = self.V.dofmap.index_map
         n = imap.size_local + imap.num_ghosts
-        if self.degree == 1:
-            mesh = self.V.mesh
-            ids = np.empty(n, dtype=np.int64)
-            geo = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)
-            ids[self.V.dofmap.list.array] = geo[mesh.geometry.dofmap.array]
-            return ids
         return imap.local_to_global(np.arange(n, dtype=np.int32)).astype(np.int64) + (np.int64(1) << 32)
-
-    def checkpoint(self) -> np.ndarray:
-        return self.state.x.array.copy()
-
-    def restore(self, cp: np.ndarray) -> None:
-        self.state.x.array[:] = cp
 
     def _global_order(self) -> tuple[np.ndarray, np.ndarray]:
         """(coordinates of owned blocks, their rank in a partition-independent ordering) on every rank."""
@@ -318,6 +292,9 @@ class Solid(PrescribedMotion):
         return out
 
     def from_global(self, values: np.ndarray) -> np.ndarray:
+        if values.shape[0] != self.V.dofmap.index_map.size_global:
+            raise ValueError(f"the checkpoint holds {values.shape[0]} nodes; this solid has "
+                             f"{self.V.dofmap.index_map.size_global}: it was written for another mesh")
         _, idx = self._global_order()
         n_owned = self.V.dofmap.index_map.size_local
         out = np.zeros((n_owned + self.V.dofmap.index_map.num_ghosts, self.ndof))
@@ -327,31 +304,50 @@ class Solid(PrescribedMotion):
         f.x.scatter_forward()
         return f.x.array.copy()
 
-    # -- read-out ------------------------------------------------------------------
-    def reaction(self, where: str, values: np.ndarray) -> np.ndarray:
-        """Sum over the dofs of group ``where`` (owned, all ranks) of a nodal vector (local array of V)."""
-        blocks = self._dof_blocks(where)
-        blocks = blocks[blocks < self.V.dofmap.index_map.size_local]
-        local = values.reshape(-1, self.ndof)[blocks].sum(axis=0) if len(blocks) else np.zeros(self.ndof)
-        out = np.zeros(self.ndof)
-        self.comm.Allreduce(np.ascontiguousarray(local, dtype=float), out, op=MPI.SUM)
-        return out
-
-    def nodal_values(self, where: str) -> np.ndarray:
-        """Displacement at the (first) vertex node of group ``where``, the same on every rank."""
-        blocks = dolfinx.fem.locate_dofs_topological(self.V, 0, self.tmesh.vertices(where))
-        blocks = blocks[blocks < self.V.dofmap.index_map.size_local]
-        local = np.zeros(self.ndof + 1)
-        if len(blocks):
-            local[: self.ndof] = self.state.x.array.reshape(-1, self.ndof)[blocks[0]]
-            local[self.ndof] = 1.0
-        for v in self.comm.allgather(local):
-            if v[self.ndof] == 1.0:
-                return v[: self.ndof].copy()
-        raise ValueError(f"group '{where}' has no node")
-
-    def nodes(self) -> tuple[np.ndarray, np.ndarray]:
-        n_owned = self.V.dofmap.index_map.size_local
-        X = self.V.tabulate_dof_coordinates()[:n_owned, : self.gdim]
-        u = self.state.x.array.reshape(-1, self.ndof)[:n_owned]
-        return np.concatenate(self.comm.allgather(X)), np.concatenate(self.comm.allgather(u))
+    # -- contact surface -------------------------------------------------------------
+    def surface(self, where: str) -> Surface:
+        """The boundary lines of facet group ``where`` of a linear 2D solid, oriented with the body on
+        the left; its stiffness scale is the smallest plane-strain modulus E/(1 − ν²) of the solid."""
+        if self.gdim != 2:
+            return super().surface(where)
+        if self.degree != 1:
+            raise SurfaceError(f"contact surface '{where}': node-to-segment contact needs linear solids "
+                               f"(degree 1); this solid has degree {self.degree}")
+        tm = self.tmesh
+        facets = tm.facets(where)
+        if facets is None:
+            raise SurfaceError(f"contact surface '{where}' is not a group of boundary lines of the solid mesh "
+                               f"(groups: {sorted(tm.groups)})")
+        mesh = tm.mesh
+        mesh.topology.create_connectivity(1, 2)
+        mesh.topology.create_connectivity(1, 0)
+        f2c = mesh.topology.connectivity(1, 2)
+        f2v = mesh.topology.connectivity(1, 0)
+        c2v = mesh.topology.connectivity(2, 0)
+        n_owned_cells = mesh.topology.index_map(2).size_local
+        Xdof = self.V.tabulate_dof_coordinates()[:, :2]
+        seg_blocks, inner = [], 0
+        for f in facets:
+            cells = f2c.links(f)
+            if len(cells) != 1:
+                inner += 1
+                continue
+            c = cells[0]
+            if c >= n_owned_cells:
+                continue  # the owner of the cell adds this facet
+            cv = list(c2v.links(c))
+            cd = self.V.dofmap.cell_dofs(c)
+            a, b = (cd[cv.index(v)] for v in f2v.links(f))
+            centroid = Xdof[cd].mean(axis=0)
+            t = Xdof[b] - Xdof[a]
+            n = np.array([t[1], -t[0]])
+            if np.dot(0.5 * (Xdof[a] + Xdof[b]) - centroid, n) < 0.0:
+                a, b = b, a  # the body on the left of a -> b
+            seg_blocks.append((a, b))
+        if self.comm.allreduce(inner, op=MPI.SUM):  # raised on every rank
+            raise SurfaceError(f"contact surface '{where}': some of its lines lie inside the solid, "
+                               "not on its boundary")
+        E, nu = self.E.x.array, self.nu.x.array
+        modulus = self.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN)
+        return gather_surface(self, where, np.array(seg_blocks, dtype=np.int64).reshape(-1, 2), Xdof,
+                              modulus=modulus)

@@ -1,0 +1,79 @@
+"""The one module that touches DOLFINx 0.5.2's private API (its C++ layer and private helpers).
+
+* :func:`kernel_form`: a numba ``cfunc`` element kernel (ufcx ``tabulate_tensor``
+  signature) as a ``dolfinx.cpp.fem.Form_float64`` on a part's function space,
+  so that DOLFINx handles dofmaps, ghosts, sparsity and Dirichlet rows
+  (dolfinx-0.5 notes §2).
+* :func:`index_map`, :func:`sparsity_pattern`, :func:`petsc_matrix`,
+  :func:`petsc_vector`: a global numbering and a matrix over several meshes
+  (parts stacked by :class:`dolfinx_corot.assembly.layout.DofLayout`); only
+  :mod:`dolfinx_corot.assembly.petsc` calls the two PETSc factories.
+* :func:`assemble_matrix_into`: a form's matrix added to an existing PETSc
+  matrix through its current local-to-global map (no Dirichlet rows).
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+import dolfinx
+import dolfinx.cpp
+import dolfinx.fem
+import dolfinx.fem.petsc
+import dolfinx.mesh
+
+
+def kernel_form(V: dolfinx.fem.FunctionSpace, kernel_address: int, rank: int,
+                coefficients: Sequence[dolfinx.fem.Function], constants: Sequence[dolfinx.fem.Constant],
+                cells: np.ndarray | None = None):
+    """A DOLFINx form whose cell integral is a compiled kernel.
+
+    V: the argument space (test, and trial for rank 2); kernel_address: the
+    address of a numba cfunc; coefficients are packed into ``w`` in order,
+    constants into ``c``; cells: owned cells to integrate over (all if None).
+    """
+    mesh = V.mesh
+    if cells is None:
+        integrals = {dolfinx.cpp.fem.IntegralType.cell: ([(-1, kernel_address)], None)}
+    else:
+        tdim = mesh.topology.dim
+        cells = np.unique(np.asarray(cells, dtype=np.int32))
+        tags = dolfinx.mesh.meshtags(mesh, tdim, cells, np.ones(len(cells), dtype=np.int32))
+        integrals = {dolfinx.cpp.fem.IntegralType.cell: ([(1, kernel_address)], tags)}
+    spaces = [V._cpp_object] * rank
+    return dolfinx.cpp.fem.Form_float64(spaces, integrals, [c._cpp_object for c in coefficients],
+                                        [c._cpp_object for c in constants], False)
+
+
+def index_map(comm, n_owned: int, ghosts: np.ndarray, owners: np.ndarray):
+    """A scalar IndexMap: ``n_owned`` owned indices, then ``ghosts`` (global) owned by ``owners``."""
+    return dolfinx.cpp.common.IndexMap(comm, n_owned, ghosts.astype(np.int64), owners.astype(np.int32))
+
+
+def sparsity_pattern(comm, imap, blocks: Sequence[np.ndarray], n_owned: int):
+    """The assembled pattern over ``imap`` of the dense couplings of each row of every array in
+    ``blocks`` ((k, n) local indices), with the owned diagonal."""
+    sp = dolfinx.cpp.la.SparsityPattern(comm, [imap, imap], [1, 1])
+    for dofs in blocks:
+        for row in dofs:
+            sp.insert(row, row)
+    sp.insert_diagonal(np.arange(n_owned, dtype=np.int32))
+    sp.assemble()
+    return sp
+
+
+def petsc_matrix(comm, pattern):
+    """A PETSc AIJ matrix of an assembled sparsity pattern (local-to-global map set)."""
+    return dolfinx.cpp.la.petsc.create_matrix(comm, pattern)
+
+
+def petsc_vector(imap, block_size: int = 1):
+    """A ghosted PETSc vector over an IndexMap."""
+    return dolfinx.cpp.la.petsc.create_vector(imap, block_size)
+
+
+def assemble_matrix_into(A, form) -> None:
+    """A += the matrix of ``form`` (ADD_VALUES through A's local-to-global map; no Dirichlet rows)."""
+    dolfinx.cpp.fem.petsc.assemble_matrix(A, form, dolfinx.fem.petsc._pack_constants(form),
+                                          dolfinx.fem.petsc._pack_coefficients(form), [], True)

@@ -1,0 +1,215 @@
+"""Every PETSc object of the package is made here: vectors, matrices, the extra matrix of
+declared couplings, near-nullspaces, local-to-global maps, and the linear solver.
+
+The linear solver (:class:`LinearSolver`) is MUMPS — LDLᵀ for symmetric tangents
+(its count of negative pivots is the number of negative eigenvalues of K,
+Sylvester's law) or LU — or, for continua, CG preconditioned by
+smoothed-aggregation AMG with the rigid-body near-nullspace on a block (BAIJ)
+matrix, whose failed solves (an indefinite tangent) are repeated with MUMPS LU.
+PETSc options with the solver's prefix (``dc_newton_``) override all of it
+(e.g. ``-dc_newton_pc_type lu``).
+"""
+from __future__ import annotations
+
+import logging
+from typing import Sequence
+
+import numpy as np
+from petsc4py import PETSc
+
+import dolfinx.fem.petsc
+import dolfinx.la
+
+from .. import _dolfinx
+
+logger = logging.getLogger(__name__)
+
+
+# -- vectors and matrices ---------------------------------------------------------------
+def form_matrix(a, mat_type: str | None = None) -> PETSc.Mat:
+    """The matrix of a DOLFINx bilinear form (its sparsity), AIJ or ``mat_type``."""
+    return dolfinx.fem.petsc.create_matrix(a, mat_type)
+
+
+def form_vector(L) -> PETSc.Vec:
+    """A ghosted vector laid out like the test space of a linear form."""
+    return dolfinx.fem.petsc.create_vector(L)
+
+
+def layout_matrix(comm, imap, blocks: Sequence[np.ndarray], n_owned: int) -> PETSc.Mat:
+    """AIJ matrix over a :class:`~dolfinx_corot.assembly.layout.DofLayout` whose pattern couples
+    the local indices of each row of every (k, n) array of ``blocks``."""
+    return _dolfinx.petsc_matrix(comm, _dolfinx.sparsity_pattern(comm, imap, blocks, n_owned))
+
+
+def layout_vector(imap) -> PETSc.Vec:
+    return _dolfinx.petsc_vector(imap, 1)
+
+
+def duplicate(v: PETSc.Vec, count: int = 1):
+    """``count`` new vectors laid out like ``v`` (one vector if count is 1)."""
+    out = [v.duplicate() for _ in range(count)]
+    return out[0] if count == 1 else out
+
+
+def copy(v: PETSc.Vec) -> PETSc.Vec:
+    return v.copy()
+
+
+def coupling_matrix(comm, sizes, ownership: tuple[int, int], entries: np.ndarray) -> PETSc.Mat:
+    """AIJ matrix of the given (global row, global column) entries ((k, 2), gathered on every rank),
+    laid out like a matrix of ``sizes``; inserting outside the pattern is an error."""
+    start, stop = ownership
+    mine = entries[(entries[:, 0] >= start) & (entries[:, 0] < stop)]
+    indptr = np.searchsorted(mine[:, 0], np.arange(start, stop + 1)).astype(PETSc.IntType)
+    C = PETSc.Mat().create(comm=comm)
+    C.setSizes(sizes)
+    C.setType("aij")
+    C.setPreallocationCSR((indptr, mine[:, 1].astype(PETSc.IntType)))
+    C.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
+    return C
+
+
+def lgmap(comm, indices: np.ndarray) -> PETSc.LGMap:
+    return PETSc.LGMap().create(np.asarray(indices).astype(PETSc.IntType), comm=comm)
+
+
+def near_nullspace(comm, imap, block_size: int, modes: Sequence[np.ndarray]) -> PETSc.NullSpace:
+    """Orthonormalized near-nullspace from owned nodal arrays ``modes`` ((n_owned, block_size) each)."""
+    vecs = []
+    for m in modes:
+        vec = dolfinx.la.create_petsc_vector(imap, block_size)
+        vec.array[:] = np.asarray(m).ravel()
+        vecs.append(vec)
+    dolfinx.la.orthonormalize(vecs)
+    return PETSc.NullSpace().create(vectors=vecs, comm=comm)
+
+
+def destroy(*objects) -> None:
+    for obj in objects:
+        if obj is not None:
+            obj.destroy()
+
+
+# -- the linear solver ------------------------------------------------------------------
+class LinearSolver:
+    """K x = b with the last tangent: MUMPS (``iterative=False``) or CG/GMRES + AMG.
+
+    symmetric: LDLᵀ (MUMPS) and CG; nullspace: the rigid-body modes for AMG;
+    fixed_rtol: a linear problem (no adaptive forcing)."""
+
+    def __init__(self, comm, A: PETSc.Mat, iterative: bool, symmetric: bool, options_prefix: str = "dc_newton_",
+                 nullspace: PETSc.NullSpace | None = None, fixed_rtol: bool = False):
+        self.comm = comm
+        self.A = A
+        self.iterative = iterative
+        self.ksp = PETSc.KSP().create(comm)
+        self.ksp.setOptionsPrefix(options_prefix)
+        pc = self.ksp.getPC()
+        self._fallback: PETSc.KSP | None = None
+        self.fallback_solves = 0
+        self.krylov_iterations = 0  # summed over iterative solves
+        self._nullspace = nullspace
+        if iterative:
+            # CG + smoothed-aggregation AMG with the rigid-body near-nullspace (continua): ML
+            # (Trilinos) with Chebyshev–Jacobi smoothing where PETSc has it, else PETSc's GAMG
+            self.ksp.setType("cg" if symmetric else "gmres")
+            if PETSc.Sys.hasExternalPackage("ml"):
+                pc.setType("ml")
+                # aggregation across rank boundaries (MIS) pays on several ranks, not on one
+                defaults = {"pc_ml_nullspace": "user", "mg_levels_ksp_type": "chebyshev",
+                            "mg_levels_pc_type": "jacobi",
+                            "pc_ml_CoarsenScheme": "MIS" if comm.size > 1 else "Uncoupled"}
+                options = PETSc.Options()
+                for key, value in defaults.items():
+                    if not options.hasName(options_prefix + key):
+                        options[options_prefix + key] = value
+                # kept under our prefix: ML reads its level options at every set-up, not only now
+            else:
+                pc.setType("gamg")
+            self.ksp.setTolerances(rtol=1e-10, atol=1e-50, max_it=500)
+            A.setNearNullSpace(nullspace)
+            # a tolerance given as a PETSc option is kept
+            self._fixed_rtol = PETSc.Options().hasName(options_prefix + "ksp_rtol") or fixed_rtol
+        else:
+            self.ksp.setType("preonly")
+            pc.setType("cholesky" if symmetric else "lu")
+            pc.setFactorSolverType("mumps")
+            self._fixed_rtol = True
+        self.ksp.setFromOptions()
+        # AMG needs AIJ: a converted copy of the block matrix builds the preconditioner
+        self.P: PETSc.Mat | None = None
+        self._block = A.getType() in ("baij", "mpibaij", "seqbaij")
+        self.ksp.setOperators(A)
+        self.mumps = self.ksp.getType() == "preonly" and pc.getType() in ("lu", "cholesky") \
+            and pc.getFactorSolverType() == "mumps"
+        self.ldlt = self.mumps and pc.getType() == "cholesky"
+        if self.mumps:
+            # null-pivot detection (ICNTL 24): a singular tangent is reported, not solved
+            pc.setFactorSetUpSolverType()
+            pc.getFactorMatrix().setMumpsIcntl(24, 1)
+
+    def operator_changed(self) -> None:
+        """The tangent A was re-assembled: the AIJ copy that AMG smooths with follows it."""
+        if not self._block or not self.iterative:
+            return
+        if self.P is None:
+            self.P = self.A.convert("aij", PETSc.Mat())  # a new matrix (out=None converts in place)
+            self.P.setNearNullSpace(self._nullspace)
+            self.ksp.setOperators(self.A, self.P)
+        else:
+            self.A.convert("aij", self.P)
+
+    def solve(self, rhs: PETSc.Vec, out: PETSc.Vec) -> None:
+        """out = K⁻¹ rhs; raises numpy.linalg.LinAlgError for a failed solve or a singular K."""
+        self.ksp.solve(rhs, out)
+        reason = self.ksp.getConvergedReason()
+        if self.iterative:
+            self.krylov_iterations += self.ksp.getIterationNumber()
+        if reason < 0 and self.iterative:
+            # CG + GAMG fails on an indefinite tangent (past a bifurcation or a limit point):
+            # this solve is repeated with a sparse LU (MUMPS); the next ones try CG again
+            logger.warning("CG + GAMG failed (PETSc reason %d after %d iterations): solving with MUMPS LU",
+                           reason, self.ksp.getIterationNumber())
+            reason = self._direct_solve(rhs, out)
+        if reason < 0:
+            raise np.linalg.LinAlgError(f"linear solve failed (PETSc reason {reason}); "
+                                        "the tangent may be singular (a missing support?)")
+        if self.mumps:
+            null_pivots = self.ksp.getPC().getFactorMatrix().getMumpsInfog(28)
+            if null_pivots > 0:
+                raise np.linalg.LinAlgError(
+                    f"the tangent stiffness is singular ({null_pivots} zero pivot(s)): a missing support "
+                    "(rigid-body motion), a mechanism, or a limit point under load control")
+
+    def _direct_solve(self, rhs: PETSc.Vec, out: PETSc.Vec) -> int:
+        if self._fallback is None:
+            self._fallback = PETSc.KSP().create(self.comm)
+            self._fallback.setType("preonly")
+            pc = self._fallback.getPC()
+            pc.setType("lu")
+            pc.setFactorSolverType("mumps")
+        self._fallback.setOperators(self.A)
+        self._fallback.solve(rhs, out)
+        self.fallback_solves += 1
+        return self._fallback.getConvergedReason()
+
+    def set_forcing(self, eta: float | None) -> None:
+        """Relative tolerance of the next iterative solves (inexact Newton; None: back to 1e-10);
+        ignored by direct solvers and when ``-<prefix>ksp_rtol`` was given."""
+        if self.iterative and not self._fixed_rtol:
+            self.ksp.setTolerances(rtol=1e-10 if eta is None else eta)
+
+    def reuse_preconditioner(self, reuse: bool) -> None:
+        """Keep the preconditioner of an earlier tangent for the next iterative solves."""
+        if self.iterative:
+            self.ksp.getPC().setReusePreconditioner(bool(reuse))
+
+    def negative_eigenvalues(self) -> int | None:
+        """Number of negative eigenvalues of the last factorized tangent (LDLᵀ only; else None)."""
+        if not self.ldlt:
+            return None
+        return int(self.ksp.getPC().getFactorMatrix().getMumpsInfog(12))
+
+    def destroy(self) -> None:
+        destroy(self._fallback, self.P, self.ksp)

@@ -1,0 +1,643 @@
+r"""The nonlinear system that the solvers see: a sum of the parts' forms and of contributions.
+
+:math:`\mathbf r(\mathbf x, \lambda) = \lambda\mathbf f_{ext} + \sum_g g(\lambda)\mathbf f_g
+- \mathbf f_{int}(\mathbf x)`, with f_int the parts' internal forces (their forms,
+assembled by DOLFINx) plus the forces of every
+:class:`~dolfinx_corot.assembly.contribution.Contribution` (contact today).
+The tangent is the parts' matrix plus the contributions' blocks, gathered in a
+matrix over the union of their declared couplings (built once per change of
+couplings). The system also relays Newton's hooks to the contributions and
+holds their state with the parts' for step cutting and checkpoint files.
+
+:class:`System` is one part model on one mesh (DOLFINx's own layout);
+:class:`CoupledSystem` stacks models on several meshes with a
+:class:`~dolfinx_corot.assembly.layout.DofLayout`. Newton increments are
+homogeneous on supported dofs. The system knows nothing about beams or contact.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+from typing import Protocol, Sequence
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem
+import dolfinx.fem.petsc
+
+from .. import _dolfinx
+from . import petsc
+from .contribution import Contribution
+from .layout import DofLayout
+
+logger = logging.getLogger(__name__)
+
+
+class Model(Protocol):
+    """What :class:`System` and the drivers need from the assembled part(s)."""
+
+    V: dolfinx.fem.FunctionSpace                              # space of the Newton corrections
+    state: dolfinx.fem.Function                               # the configuration (kernels' coefficient)
+    symmetric_tangent: bool                                   # LDLᵀ allowed
+    has_prescribed_motion: bool
+    amplitudes: list                                          # distinct load amplitudes (None: ∝ λ)
+    large_rotations: bool
+
+    def forms(self) -> tuple[object, object]: ...            # (vector form, matrix form)
+    def dirichlet_bcs(self) -> list: ...                        # supports and prescribed motion
+    def set_load_factor(self, load_factor: float) -> None: ...  # prescribed values at λ
+    def external_force(self, b: PETSc.Vec, amplitude=None) -> None: ...  # unit loads of one amplitude
+    def displacement_vector(self) -> PETSc.Vec: ...             # x in the layout of V (constraints)
+    def update(self, dx: PETSc.Vec) -> None: ...                # x ← x ⊕ dx
+    def extrapolate(self, older: object, newer: object, factor: float) -> None: ...
+    def checkpoint(self) -> object: ...
+    def restore(self, cp: object) -> None: ...
+    def to_global(self, local: np.ndarray) -> np.ndarray | None: ...   # for checkpoint files
+    def from_global(self, values: np.ndarray) -> np.ndarray: ...
+
+
+@dataclass
+class Timings:
+    """Accumulated wall time (s) of the phases of the Newton iterations; ``contributions``:
+    the part of assembly spent in contributions (search, kernels, their matrix)."""
+
+    assembly: float = 0.0
+    solve: float = 0.0
+    update: float = 0.0
+    contributions: float = 0.0
+
+    def copy(self) -> "Timings":
+        return Timings(self.assembly, self.solve, self.update, self.contributions)
+
+
+class System:
+    """Nonlinear system r(x, λ) = λ f_ext − f_int(x) = 0 of one model plus contributions.
+
+    solver: 'direct' (MUMPS LDLᵀ when ``symmetric``, else LU) or 'iterative'
+    (CG + AMG with the rigid-body near-nullspace, on a block matrix; see
+    :class:`~dolfinx_corot.assembly.petsc.LinearSolver`).
+    contributions: :class:`~dolfinx_corot.assembly.contribution.Contribution` objects
+    (e.g. the scene's contact) summed into the residual and tangent.
+    """
+
+    def __init__(self, model: Model, options_prefix: str = "dc_newton_", symmetric: bool | None = None,
+                 solver: str = "direct", contributions: Sequence[Contribution] = ()):
+        self.model = model
+        self.comm = model.comm
+        # block-compressed rows for AMG on continua: nodal blocks are inserted and multiplied
+        # several times faster than in AIJ; MUMPS gets AIJ
+        self._mat_type = "baij" if solver == "iterative" else None
+        self._build()
+        self.fint, self.dx, self.step_dx, self.lift, self.fext_total, self._rhs = petsc.duplicate(self.b, 6)
+        self.has_prescribed_motion = bool(getattr(model, "has_prescribed_motion", False))
+        self.load_factor = 0.0
+        self.fext = self._external_force(None)
+        self.reference_load_norm = self.fext.norm()
+        # loads with their own amplitudes g(λ)
+        self.amplitude_loads = [(amp, self._external_force(amp)) for amp in getattr(model, "amplitudes", [])]
+        self.timings = Timings()
+        self.contributions = list(contributions)
+        if self.contributions and solver == "iterative":
+            raise NotImplementedError(f"{self.contributions[0].name} needs the direct solver "
+                                      "(linear_solver='direct' or 'auto')")
+        for c in self.contributions:
+            c.bind(self)
+        self.C: PETSc.Mat | None = None   # the contributions' matrix over their declared couplings
+        self._merged = False
+        self.pattern_builds = 0
+        self.engaged = False
+        if symmetric is None:
+            symmetric = getattr(model, "symmetric_tangent", True)
+        self.iterative = solver == "iterative"
+        nullspace = None
+        if self.iterative:
+            nullspace = petsc.near_nullspace(self.comm, model.V.dofmap.index_map, model.V.dofmap.index_map_bs,
+                                             model.near_nullspace_modes())
+        self.linear = petsc.LinearSolver(self.comm, self.A, self.iterative, symmetric, options_prefix, nullspace,
+                                         fixed_rtol=not getattr(model, "large_rotations", True))
+
+    # -- layout (one mesh: DOLFINx's own) -------------------------------------------
+    def _build(self) -> None:
+        self.L, self.a = self.model.forms()
+        self.bcs = self.model.dirichlet_bcs()
+        self.A = petsc.form_matrix(self.a, self._mat_type)
+        self.b = petsc.form_vector(self.L)
+
+    def _external_force(self, amplitude) -> PETSc.Vec:
+        """Assembled unit external load of one amplitude (None: the loads proportional to λ)."""
+        v = petsc.duplicate(self.b)
+        with v.localForm() as f:
+            f.set(0.0)
+        self.model.external_force(v, amplitude)
+        v.assemble()
+        return v
+
+    def _assemble_parts(self) -> None:
+        with self.fint.localForm() as f:
+            f.set(0.0)
+        dolfinx.fem.petsc.assemble_vector(self.fint, self.L)
+        self.fint.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+
+    def _assemble_fint(self) -> None:
+        self._assemble_parts()
+        if self.contributions:
+            t = time.perf_counter()
+            self._add_blocks(self.fint, lambda c, add: c.add_residual(add))
+            # something is near: the contributions' matrix and Newton's safeguards are needed
+            self.engaged = bool(self.comm.allreduce(any(c.engaged() for c in self.contributions), op=MPI.LOR))
+            self.timings.contributions += time.perf_counter() - t
+
+    def _add_blocks(self, vec: PETSc.Vec, call) -> None:
+        """vec += the blocks each contribution adds through ``call(contribution, add)`` (global dofs)."""
+        def add(dofs, values):
+            d = np.asarray(dofs).ravel().astype(PETSc.IntType)
+            v = np.asarray(values, dtype=float).ravel()
+            free = d >= 0  # (a vector, unlike a matrix, does not skip negative indices)
+            vec.setValues(d[free], v[free], addv=PETSc.InsertMode.ADD_VALUES)
+
+        for c in self.contributions:
+            call(c, add)
+        vec.assemblyBegin()
+        vec.assemblyEnd()
+
+    def _constrain_residual(self, load_factor: float) -> None:
+        x = self.model.displacement_vector()
+        if self.has_prescribed_motion:
+            self.model.set_load_factor(load_factor)
+            with self.lift.localForm() as f:
+                f.set(0.0)
+            # supports never move (x = 0 there): only prescribed motion has a lifting
+            lifting_bcs = getattr(self.model, "lifting_bcs", self.bcs)
+            dolfinx.fem.petsc.apply_lifting(self.lift, [self.a], bcs=[lifting_bcs], x0=[x], scale=1.0)
+            self.lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            self.b.axpy(1.0, self.lift)
+        dolfinx.fem.petsc.set_bc(self.b, self.bcs, x, 1.0)
+
+    def model_array(self, model, vec: PETSc.Vec) -> np.ndarray:
+        """Local values (owned and ghost) of ``vec`` in the layout of ``model.V``."""
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with vec.localForm() as f:
+            return f.array.copy()
+
+    @property
+    def models(self) -> list:
+        """The part models of the system."""
+        return [self.model]
+
+    # -- checkpoint files: node-ordered arrays -------------------------------------
+    def global_arrays(self, vectors: dict) -> dict:
+        """Configuration, contribution states and vectors as node-ordered arrays on rank 0."""
+        arrays = {}
+        for i, m in enumerate(self.models):
+            arrays[f"state{i}"] = m.to_global(m.state.x.array)
+            for name, vec in vectors.items():
+                arrays[f"{name}{i}"] = m.to_global(self.model_array(m, vec))
+        for i, c in enumerate(self.contributions):
+            for key, value in c.state_arrays().items():
+                arrays[f"contribution{i}_{key}"] = value
+        return arrays
+
+    def set_global_arrays(self, arrays: dict) -> None:
+        """Restore configuration and contribution states from :meth:`global_arrays`' output."""
+        for i, m in enumerate(self.models):
+            m.state.x.array[:] = m.from_global(arrays[f"state{i}"])
+        for i, c in enumerate(self.contributions):
+            prefix = f"contribution{i}_"
+            c.set_state_arrays({k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)})
+
+    def global_to_vector(self, arrays: dict, name: str, vec: PETSc.Vec) -> None:
+        """Fill ``vec`` (owned and ghost) from the arrays of :meth:`global_arrays` (entry ``name``)."""
+        with vec.localForm() as v:
+            v.array[:] = self.model.from_global(arrays[f"{name}0"])
+
+    # -- residual -----------------------------------------------------------
+    def residual(self, load_factor: float) -> tuple[float, float]:
+        """Assemble b = λ f_ext + Σ g(λ) f_g − f_int; on constrained dofs b = ū(λ) − x (0 on supports).
+
+        With prescribed displacements the columns of constrained dofs are
+        lifted, b_f −= K_fc (ū − x)_c, so that one Newton correction honours
+        them exactly. Returns (‖b‖, reference force norm) where the
+        reference is the larger of the external load's norm and ‖f_int‖ over
+        all dofs (reactions included).
+        """
+        t = time.perf_counter()
+        self.load_factor = load_factor
+        self._assemble_fint()
+        self.fext.copy(self.fext_total)
+        self.fext_total.scale(load_factor)
+        for amp, v in self.amplitude_loads:
+            self.fext_total.axpy(amp(load_factor), v)
+        ref = max(self.fext_total.norm(), self.fint.norm())
+        self.fext_total.copy(self.b)
+        self.b.axpy(-1.0, self.fint)
+        self._constrain_residual(load_factor)
+        norm = self.b.norm()
+        self.timings.assembly += time.perf_counter() - t
+        return norm, ref
+
+    def _assemble_parts_matrix(self) -> None:
+        self.A.zeroEntries()
+        dolfinx.fem.petsc.assemble_matrix(self.A, self.a, bcs=self.bcs)
+        self.A.assemble()
+
+    def jacobian(self) -> None:
+        """Assemble the tangent K = ∂f_int/∂x (parts and contributions), identity rows/columns on
+        supports."""
+        t = time.perf_counter()
+        self._assemble_parts_matrix()
+        self._add_contribution_tangents()
+        self._constrain_matrix()
+        self.linear.operator_changed()
+        self.timings.assembly += time.perf_counter() - t
+
+    def _constrain_matrix(self) -> None:
+        """Constrained rows and columns (DOLFINx's assembly did them for one mesh)."""
+
+    def _add_contribution_tangents(self) -> None:
+        """A += C, the contributions' tangent blocks in a matrix over their declared couplings
+        (nothing while no contribution is engaged: bodies far apart cost a search, no matrix work)."""
+        if not self.engaged:
+            return
+        t = time.perf_counter()
+        A = self.A
+        if self.C is None or any(c.couplings_changed for c in self.contributions):
+            self._build_couplings(A)
+        C = self.C
+        C.zeroEntries()
+
+        def add(dofs, K):
+            d = np.asarray(dofs).astype(PETSc.IntType)
+            C.setValuesRCV(d, d, K, addv=PETSc.InsertMode.ADD_VALUES)
+
+        for c in self.contributions:
+            c.add_tangent(add)
+        C.assemble()
+        lgmap = A.getLGMap()
+        A.axpy(1.0, C, PETSc.Mat.Structure.SUBSET if self._merged else PETSc.Mat.Structure.DIFFERENT)
+        if not self._merged:
+            A.setLGMap(*lgmap)  # a new pattern replaces the matrix's internals
+            self._merged = True
+        self.timings.contributions += time.perf_counter() - t
+
+    def _build_couplings(self, A: PETSc.Mat) -> None:
+        """C's pattern: the dense blocks every contribution of every rank declares."""
+        entries = []
+        for c in self.contributions:
+            dofs = c.couplings()
+            if dofs.size:
+                n = dofs.shape[1]
+                r, q = np.repeat(dofs, n, axis=1).ravel(), np.tile(dofs, (1, n)).ravel()
+                keep = (r >= 0) & (q >= 0)
+                entries.append(np.unique(np.stack([r[keep], q[keep]], axis=1), axis=0))
+        local = np.concatenate(entries) if entries else np.zeros((0, 2), dtype=np.int64)
+        allentries = np.unique(np.concatenate(self.comm.allgather(local.astype(np.int64))), axis=0)
+        petsc.destroy(self.C)
+        self.C = petsc.coupling_matrix(self.comm, A.getSizes(), self.ownership_range(), allentries)
+        self._merged = False
+        self.pattern_builds += 1
+        for c in self.contributions:
+            c.couplings_changed = False
+
+    # -- linear solves ------------------------------------------------------------
+    def solve(self, rhs: PETSc.Vec | None = None, out: PETSc.Vec | None = None) -> float:
+        """Solve K out = rhs (default K dx = b) with the last tangent; return ‖out‖."""
+        rhs = self.b if rhs is None else rhs
+        out = self.dx if out is None else out
+        t = time.perf_counter()
+        try:
+            self.linear.solve(rhs, out)
+        finally:
+            self.timings.solve += time.perf_counter() - t
+        return out.norm()
+
+    def set_forcing(self, eta: float | None) -> None:
+        self.linear.set_forcing(eta)
+
+    def reuse_preconditioner(self, reuse: bool) -> None:
+        self.linear.reuse_preconditioner(reuse)
+
+    def negative_eigenvalues(self) -> int | None:
+        return self.linear.negative_eigenvalues()
+
+    @property
+    def krylov_iterations(self) -> int:
+        return self.linear.krylov_iterations
+
+    @property
+    def fallback_solves(self) -> int:
+        return self.linear.fallback_solves
+
+    def reference_load(self, out: PETSc.Vec) -> None:
+        """out = f_ext with zero rows on constrained dofs (right-hand side of K dx_t = f_ext)."""
+        self.fext.copy(out)
+        dolfinx.fem.petsc.set_bc(out, self.bcs, None, 0.0)
+
+    def new_vector(self) -> PETSc.Vec:
+        """A vector laid out like the solution (ghosted)."""
+        return petsc.duplicate(self.b)
+
+    def update(self, scale: float = 1.0) -> None:
+        """x ← x ⊕ scale·dx through the model's update rule (multiplicative for rotations)."""
+        t = time.perf_counter()
+        if scale != 1.0:
+            self.dx.scale(scale)
+        self.model.update(self.dx)
+        self.step_dx.axpy(scale, self.dx)
+        if scale != 1.0:
+            self.dx.scale(1.0 / scale)
+        self.timings.update += time.perf_counter() - t
+
+    def directional_residual(self) -> float:
+        """dx·r at the last residual: minus the derivative of the energy along dx."""
+        return self.dx.dot(self.b)
+
+    # -- Newton hooks, relayed to the contributions ---------------------------------
+    def before_step(self) -> None:
+        for c in self.contributions:
+            c.before_step()
+
+    def begin_step(self) -> None:
+        """A Newton solve starts: the contributions' hook, and the sum of its corrections from 0
+        (see :meth:`step_increment_norm`)."""
+        for c in self.contributions:
+            c.before_solve()
+        with self.step_dx.localForm() as s:
+            s.set(0.0)
+
+    def correction_rhs(self) -> PETSc.Vec:
+        """The right-hand side of the next correction: b, less the forces the contributions ask
+        to take out of it (see Contribution.correction_rhs)."""
+        extra = {}
+        for c in self.contributions:
+            blocks = c.correction_rhs()
+            if blocks is not None:
+                extra[id(c)] = blocks
+        if not self.comm.allreduce(bool(extra), op=MPI.LOR):
+            return self.b
+        self.b.copy(self._rhs)
+
+        def subtract(c, add):
+            if id(c) in extra:
+                dofs, forces = extra[id(c)]
+                add(dofs, -np.asarray(forces))
+
+        self._add_blocks(self._rhs, subtract)
+        return self._rhs
+
+    def limit_correction(self) -> float:
+        """The smallest factor the contributions allow for the correction dx (≤ 1)."""
+        return min([c.limit_correction(self.dx) for c in self.contributions], default=1.0)
+
+    def needs_line_search(self) -> bool:
+        return any(c.needs_line_search() for c in self.contributions)
+
+    def after_iteration(self, residuals: list[float]) -> None:
+        for c in self.contributions:
+            c.after_iteration(residuals)
+
+    def on_converged(self) -> bool:
+        """Every contribution's update after a converged solve; True if any asks for another."""
+        return any([c.on_converged() for c in self.contributions])
+
+    def history(self, report) -> dict:
+        row = {}
+        for c in self.contributions:
+            row.update(c.history(report))
+        return row
+
+    def commit(self) -> None:
+        for c in self.contributions:
+            c.commit()
+
+    # -- state ----------------------------------------------------------------------
+    def step_increment_norm(self) -> float:
+        """‖Σ corrections‖ since :meth:`begin_step`."""
+        return self.step_dx.norm()
+
+    def extrapolate(self, older, newer, factor: float) -> None:
+        """Set x to newer ⊕ factor·(newer ⊖ older) (a secant predictor; configurations of
+        :meth:`checkpoint`)."""
+        self.model.extrapolate(older[0], newer[0], factor)
+
+    def checkpoint(self):
+        """The configuration and every contribution's history state (in memory)."""
+        return (self.model.checkpoint(), [c.checkpoint() for c in self.contributions])
+
+    def restore(self, cp) -> None:
+        self.model.restore(cp[0])
+        for c, state in zip(self.contributions, cp[1]):
+            c.restore(state)
+
+    # -- numbering ------------------------------------------------------------------
+    def global_dofs(self, model, local_dofs: np.ndarray) -> np.ndarray:
+        """Global system dofs of ``model``'s local unrolled dofs."""
+        return self.A.getLGMap()[0].apply(np.asarray(local_dofs, dtype=PETSc.IntType)).astype(np.int64)
+
+    def constrained_global_dofs(self) -> np.ndarray:
+        """All constrained dofs (supports and prescribed motion), global numbering, on every rank."""
+        own = [self.global_dofs(self.model, bc.dof_indices()[0][: bc.dof_indices()[1]]) for bc in self.bcs]
+        own = np.concatenate(own) if own else np.zeros(0, dtype=np.int64)
+        return np.unique(np.concatenate(self.comm.allgather(own)))
+
+    def ownership_range(self) -> tuple[int, int]:
+        return self.A.getOwnershipRange()
+
+    def internal_force(self) -> PETSc.Vec:
+        """f_int at the last residual, all dofs: on supported dofs it is the reaction."""
+        return self.fint
+
+    def destroy(self) -> None:
+        for c in self.contributions:
+            c.destroy()
+        self.linear.destroy()
+        petsc.destroy(self.C, self.A, self.b, self.fint, self.dx, self.step_dx, self.lift, self.fext,
+                      self.fext_total, self._rhs, *(v for _, v in self.amplitude_loads))
+
+
+class CoupledSystem(System):
+    """:class:`System` of parts on several meshes (``model.models``), stacked by a :class:`DofLayout`.
+
+    Each model's kernels are assembled by DOLFINx into one PETSc matrix
+    whose pattern is the union of the models' cell patterns: the matrix's
+    local-to-global map is switched to each model's dofs in turn, so shared
+    nodes sum their contributions. Supports and prescribed motion act on the
+    system's dofs (MatZeroRowsColumns with the lifting of prescribed values);
+    rotations without bending stiffness in every model are fixed.
+    """
+
+    def _build(self) -> None:
+        models = self.model.models
+        self.layout = lay = DofLayout(models)
+        comm = self.comm
+        blocks = []
+        for m, loc in zip(models, lay.local):
+            cells = m.V.dofmap.list.array.reshape(-1, m.nodes_per_cell)
+            blocks.append(loc[(cells[:, :, None] * m.ndof + np.arange(m.ndof)).reshape(len(cells), -1)])
+        self.A = petsc.layout_matrix(comm, lay.imap, blocks, lay.n_owned)
+        self.b = petsc.layout_vector(lay.imap)
+        self._model_forms = [m.forms() for m in models]
+        self._lgmaps = [petsc.lgmap(comm, gd) for gd in lay.gdofs]
+        self._mvec = [petsc.form_vector(L) for L, _ in self._model_forms]
+        self._xglobal = petsc.duplicate(self.b)
+        self._constraints, self._fixed = self._gather_constraints()
+        self._lift_pending = False
+
+    @property
+    def models(self) -> list:
+        return self.model.models
+
+    # -- moving values between the models' layouts and the system's ---------------
+    def _add_from_models(self, vec: PETSc.Vec, arrays: Sequence[np.ndarray]) -> None:
+        """vec = Σ over models of their local arrays (owned and ghost entries), summed on the owners."""
+        with vec.localForm() as f:
+            f.set(0.0)
+            for loc, arr in zip(self.layout.local, arrays):
+                f.array[loc] += arr
+        vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+
+    def model_array(self, model, vec: PETSc.Vec) -> np.ndarray:
+        i = self.model.models.index(model)
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with vec.localForm() as f:
+            return f.array[self.layout.local[i]].copy()
+
+    def _owned_indicator(self, arrays: Sequence[np.ndarray]) -> np.ndarray:
+        """Owned entries of Σ models' local arrays (a reduction over ranks)."""
+        self._add_from_models(self._xglobal, arrays)
+        return self._xglobal.array.copy()
+
+    def _gather_constraints(self):
+        """[(owned local rows, value, amplitude)] of supports and prescribed motion; and all fixed rows."""
+        models = self.model.models
+        groups = []
+        for i, m in enumerate(models):
+            for dofs, value, amp in m.constraint_dofs():
+                arrays = [np.zeros(len(loc)) for loc in self.layout.local]
+                arrays[i][dofs] = 1.0
+                groups.append((np.flatnonzero(self._owned_indicator(arrays) > 0).astype(np.int32), value, amp))
+        # rotations that no model gives bending stiffness
+        rot, bend = [], []
+        for m in models:
+            r = np.zeros((len(m.bending_blocks()), m.ndof))
+            r[:, m.translations:] = 1.0
+            rot.append(r.ravel())
+            bend.append((r * m.bending_blocks()[:, None]).ravel())
+        free = (self._owned_indicator(rot) > 0) & (self._owned_indicator(bend) == 0)
+        groups.append((np.flatnonzero(free).astype(np.int32), 0.0, None))
+        fixed = np.unique(np.concatenate([g[0] for g in groups])).astype(np.int32)
+        return groups, fixed
+
+    # -- System hooks --------------------------------------------------------------
+    def _external_force(self, amplitude) -> PETSc.Vec:
+        arrays = []
+        for m, v in zip(self.model.models, self._mvec):
+            with v.localForm() as f:
+                f.set(0.0)
+            m.external_force(v, amplitude)
+            with v.localForm() as f:
+                arrays.append(f.array.copy())
+        out = petsc.duplicate(self.b)
+        self._add_from_models(out, arrays)
+        return out
+
+    def _assemble_parts(self) -> None:
+        arrays = []
+        for (L, _), v in zip(self._model_forms, self._mvec):
+            with v.localForm() as f:
+                f.set(0.0)
+            dolfinx.fem.petsc.assemble_vector(v, L)
+            with v.localForm() as f:
+                arrays.append(f.array.copy())
+        self._add_from_models(self.fint, arrays)
+
+    def _displacements(self) -> np.ndarray:
+        """Owned entries of the displacement vector (rotational entries 0)."""
+        with self._xglobal.localForm() as f:
+            for m, loc in zip(self.model.models, self.layout.local):
+                with m.displacement_vector().localForm() as x:
+                    f.array[loc] = x.array
+        return self._xglobal.array
+
+    def _constrain_residual(self, load_factor: float) -> None:
+        x = self._displacements()
+        with self.lift.localForm() as f:
+            f.set(0.0)
+        lift = self.lift.array
+        for rows, value, amp in self._constraints:
+            target = value * (load_factor if amp is None else amp(load_factor))
+            lift[rows] = target - x[rows]
+        self.b.array[self._fixed] = lift[self._fixed]
+        self._lift_pending = True
+
+    def _assemble_parts_matrix(self) -> None:
+        A = self.A
+        A.zeroEntries()
+        lg0 = A.getLGMap()
+        for (_, a), lg in zip(self._model_forms, self._lgmaps):
+            A.setLGMap(lg, lg)
+            _dolfinx.assemble_matrix_into(A, a)
+        A.setLGMap(*lg0)
+        A.assemble()
+
+    def _constrain_matrix(self) -> None:
+        rows = (self._fixed + self.layout.start).astype(PETSc.IntType)
+        if self._lift_pending and self.has_prescribed_motion:
+            self.A.zeroRowsColumns(rows, 1.0, self.lift, self.b)
+        else:
+            self.A.zeroRowsColumns(rows, 1.0)
+        self._lift_pending = False
+
+    def reference_load(self, out: PETSc.Vec) -> None:
+        self.fext.copy(out)
+        out.array[self._fixed] = 0.0
+
+    def update(self, scale: float = 1.0) -> None:
+        t = time.perf_counter()
+        self.dx.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with self.dx.localForm() as f:
+            dxl = f.array
+            for m, loc, v in zip(self.model.models, self.layout.local, self._mvec):
+                n = m.V.dofmap.index_map.size_local * m.ndof
+                v.array[:] = scale * dxl[loc[:n]]
+                m.update(v)
+        self.step_dx.axpy(scale, self.dx)
+        self.timings.update += time.perf_counter() - t
+
+    def global_dofs(self, model, local_dofs: np.ndarray) -> np.ndarray:
+        return self.layout.gdofs[self.model.models.index(model)][np.asarray(local_dofs)].astype(np.int64)
+
+    def constrained_global_dofs(self) -> np.ndarray:
+        own = (self._fixed + self.layout.start).astype(np.int64)
+        return np.unique(np.concatenate(self.comm.allgather(own)))
+
+    def ownership_range(self) -> tuple[int, int]:
+        return self.layout.start, self.layout.start + self.layout.n_owned
+
+    def global_to_vector(self, arrays: dict, name: str, vec: PETSc.Vec) -> None:
+        with vec.localForm() as f:
+            for i, (m, loc) in enumerate(zip(self.model.models, self.layout.local)):
+                f.array[loc] = m.from_global(arrays[f"{name}{i}"])
+
+    def destroy(self) -> None:
+        super().destroy()
+        petsc.destroy(*self._mvec, self._xglobal, *self._lgmaps)
+
+
+def make_system(model, solver: str = "auto", contributions: Sequence[Contribution] = (), **kwargs) -> System:
+    """The :class:`System` of a model: DOLFINx's layout for one mesh, a :class:`CoupledSystem` for several.
+
+    solver: 'direct' (MUMPS), 'iterative' (CG + AMG with the rigid-body near-nullspace) or
+    'auto': iterative for a continuum alone without contributions, direct otherwise.
+    contributions: added to the parts' residual and tangent (e.g. ``scene.contributions()``).
+    """
+    continuum = getattr(model, "near_nullspace_modes", None) is not None
+    if solver == "auto":
+        solver = "iterative" if continuum and not contributions else "direct"
+    if solver == "iterative" and not continuum:
+        raise NotImplementedError("the iterative solver (CG + GAMG) is for continua alone; structures and coupled "
+                                  "parts use the direct solver")
+    cls = CoupledSystem if hasattr(model, "models") else System
+    return cls(model, solver=solver, contributions=contributions, **kwargs)

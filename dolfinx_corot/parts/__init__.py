@@ -1,0 +1,34 @@
+"""Parts: the models of beams, bars, shells, membranes and continua on DOLFINx meshes.
+
+Every part shares one base (:class:`~.base.Part`: nodes, dofs, supports, prescribed
+motion, loads, reactions, monitors, checkpoint state, reference configuration) and
+answers ``part.surface(group)`` with a :class:`~.surface.Surface`. :func:`part_for_mesh`
+chooses the part model a mesh carries; nothing outside this package asks for a
+concrete part class.
+"""
+from .base import Motion, Part, PartRef, global_sum, owned_dofs_of_vertices
+from .coupled import Coupled
+from .frame import Frame2D, Frame3D, LineFrame
+from .shell import MembraneQuad, Shell3D, Surface3D
+from .solid import Solid
+from .surface import Surface, SurfaceError
+
+__all__ = ["Coupled", "Frame2D", "Frame3D", "LineFrame", "MembraneQuad", "Motion", "Part", "PartRef", "Shell3D",
+           "Solid", "Surface", "Surface3D", "SurfaceError", "global_sum", "owned_dofs_of_vertices", "part_for_mesh"]
+
+
+def part_for_mesh(tmesh, large_rotations: bool, solid_degree: int | None = None) -> Part:
+    """The part model of a mesh: a solid (``solid_degree`` given) or the structure its cells carry
+    (lines: 2D or 3D frames; triangles in space: shells and membranes; quadrilaterals in space:
+    membranes)."""
+    mesh = tmesh.mesh
+    if solid_degree is not None:
+        return Solid(tmesh, solid_degree, large_rotations)
+    if mesh.topology.dim == mesh.geometry.dim and mesh.topology.dim > 1:
+        raise ValueError("this mesh fills its space (a continuum): use add_solid; structural parts need "
+                         "lines or surfaces in space")
+    if mesh.topology.dim == 2:
+        model = MembraneQuad if mesh.topology.cell_name() == "quadrilateral" else Shell3D
+    else:
+        model = Frame3D if mesh.geometry.dim == 3 else Frame2D
+    return model(tmesh, large_rotations)

@@ -1,0 +1,349 @@
+"""What every part shares: nodes, dofs, supports, prescribed motion, loads, reactions, monitors,
+checkpoint state and the reference configuration.
+
+A part model lives on one DOLFINx mesh: the Newton corrections in a vector space
+``V`` (one block of ``ndof`` dofs per node), the configuration in ``state``
+(``state_size`` values per node: displacements, and rotations where they exist),
+and its element forms. Subclasses say how a group of the mesh maps to dof
+blocks (:meth:`Part._entities`), what their forms are, and how the state is
+updated; everything below is written once here.
+
+Prescribed motion is a :class:`Motion`: a value times the load factor, or times
+an amplitude g(λ), or any function of (λ, stage).
+"""
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem
+
+from ..io.mesh import TaggedMesh
+from .surface import Surface, SurfaceError
+
+
+@dataclass(frozen=True)
+class PartRef:
+    """Handle to a group of elements added to a model (returned by Scene.add_*)."""
+
+    model: "Part"
+    name: str
+    kind: str
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A prescribed value of one dof: ``value`` × λ, × ``amplitude(λ)``, or ``function(λ, stage)``."""
+
+    value: float = 0.0
+    amplitude: object = None
+    function: object = None
+
+    def __call__(self, load_factor: float, stage: int | None = None) -> float:
+        if self.function is not None:
+            return float(self.function(load_factor, stage))
+        return self.value * (load_factor if self.amplitude is None else self.amplitude(load_factor))
+
+    @property
+    def moves(self) -> bool:
+        return self.function is not None or self.value != 0.0
+
+
+def owned_dofs_of_vertices(V: dolfinx.fem.FunctionSpace, vertices: np.ndarray) -> np.ndarray:
+    """Owned block indices (nodes) of V at the given local mesh vertices."""
+    blocks = dolfinx.fem.locate_dofs_topological(V, 0, vertices)
+    return blocks[blocks < V.dofmap.index_map.size_local]
+
+
+def global_sum(comm: MPI.Comm, value: np.ndarray) -> np.ndarray:
+    """Sum of an array over all ranks."""
+    out = np.zeros_like(value)
+    comm.Allreduce(np.ascontiguousarray(value), out, op=MPI.SUM)
+    return out
+
+
+def finite_vector(label: str, name: str, value, n: int) -> np.ndarray:
+    """``value`` as n finite numbers, or a ValueError naming ``label`` and ``name``."""
+    value = np.atleast_1d(np.asarray(value, dtype=float))
+    if value.shape != (n,) or not np.all(np.isfinite(value)):
+        raise ValueError(f"{label}: {name} must be {n} finite numbers, got {value.tolist()}")
+    return value
+
+
+class Part:
+    """Base of every part model (see the module docstring).
+
+    Subclasses set ``gdim``, ``tdim``, ``dof_names``, ``translations``, ``state_size``,
+    ``V``, ``state``, ``tmesh``, ``large_rotations`` and call :meth:`_init_conditions`.
+    """
+
+    gdim: int
+    tdim: int
+    dof_names: tuple[str, ...]
+    translations: int
+    state_size: int
+    continuum = False          # a solid (UFL forms) rather than a structure
+    symmetric_tangent = True
+    kind_name = "part"
+
+    def _init_conditions(self) -> None:
+        self.ndof = len(self.dof_names)
+        self.parts: list[PartRef] = []
+        self._bcs: list[tuple[np.ndarray, tuple[int, ...]]] = []
+        self._prescribed: list[tuple[tuple[int, np.ndarray], int, Motion]] = []
+        self._prescribed_values: list[tuple[dolfinx.fem.Function, np.ndarray, Motion]] = []
+        self._point_loads: list[tuple[np.ndarray, np.ndarray, object]] = []
+        self.lifting_bcs: list = []
+        self._forms = None
+        self.stage: int | None = None
+        self.capture_reference()
+
+    @property
+    def comm(self):
+        return self.V.mesh.comm
+
+    # -- groups → dofs ----------------------------------------------------------------
+    def _entities(self, where: str) -> tuple[int, np.ndarray]:
+        """(dim, local entities) that locate the dofs of group ``where`` (its vertices by default)."""
+        return 0, self.tmesh.vertices(where)
+
+    def dof_blocks(self, where: str) -> np.ndarray:
+        """Local blocks (nodes of V, owned and ghost) of group ``where``."""
+        return dolfinx.fem.locate_dofs_topological(self.V, *self._entities(where))
+
+    def owned_blocks(self, where: str) -> np.ndarray:
+        blocks = self.dof_blocks(where)
+        return blocks[blocks < self.V.dofmap.index_map.size_local]
+
+    # -- reference configuration -----------------------------------------------------
+    def capture_reference(self) -> None:
+        """Take the nodes' current positions as the stress-free reference of the part's elements
+        (at creation: the mesh; later, e.g. for a structure added in a deformed configuration)."""
+        self.reference = self.V.tabulate_dof_coordinates()[:, : self.gdim].copy()
+
+    # -- supports, prescribed motion, loads ------------------------------------------
+    def fix(self, where: str, dofs: tuple[int, ...]) -> None:
+        self._bcs.append((self.dof_blocks(where), tuple(dofs)))
+
+    def prescribe(self, where: str, comp: int, value: float, amplitude=None, function=None) -> None:
+        """Prescribed displacement of dof ``comp`` at the nodes of ``where``: ``value``·λ,
+        ``value``·amplitude(λ), or ``function(λ, stage)``."""
+        self._prescribed.append((self._entities(where), comp, Motion(float(value), amplitude, function)))
+
+    def add_load(self, where: str, values: np.ndarray, amplitude=None) -> None:
+        """Dead nodal load at every node of group ``where``: λ·values, or amplitude(λ)·values."""
+        self._point_loads.append((self.dof_blocks(where), np.asarray(values, dtype=float)[: self.ndof], amplitude))
+
+    def _load_amplitudes(self) -> list:
+        """Amplitudes of the part's loads (point loads here; distributed ones in subclasses)."""
+        return [amp for *_, amp in self._point_loads]
+
+    @property
+    def amplitudes(self) -> list:
+        """The distinct amplitudes of the loads (None: proportional to λ)."""
+        out = []
+        for amp in self._load_amplitudes():
+            if amp is not None and amp not in out:
+                out.append(amp)
+        return out
+
+    @property
+    def has_prescribed_motion(self) -> bool:
+        return any(motion.moves for *_, motion in self._prescribed)
+
+    def set_load_factor(self, load_factor: float) -> None:
+        """Set the prescribed displacements to their values at λ."""
+        for g, dofs, motion in self._prescribed_values:
+            g.x.array[dofs] = motion(load_factor, self.stage)
+
+    def _fixed_blocks(self) -> np.ndarray:
+        """Blocks whose non-translational dofs have no stiffness (fixed); none by default."""
+        return np.zeros(0, dtype=np.int32)
+
+    def dirichlet_bcs(self) -> list:
+        """Supports (zero), dofs without stiffness (zero) and prescribed displacements (their
+        values at λ, see :meth:`set_load_factor`)."""
+        zero = PETSc.ScalarType(0.0)
+        bcs = []
+        for blocks, comps in self._bcs:
+            for comp in comps:
+                bcs.append(dolfinx.fem.dirichletbc(zero, blocks * self.ndof + comp, self.V.sub(comp)))
+        free = self._fixed_blocks()
+        for comp in range(self.translations, self.ndof):
+            bcs.append(dolfinx.fem.dirichletbc(zero, free * self.ndof + comp, self.V.sub(comp)))
+        self._prescribed_values = []
+        self.lifting_bcs = []
+        for entities, comp, motion in self._prescribed:
+            Vi, _ = self.V.sub(comp).collapse()
+            g = dolfinx.fem.Function(Vi)
+            dofs = dolfinx.fem.locate_dofs_topological((self.V.sub(comp), Vi), *entities)
+            bc = dolfinx.fem.dirichletbc(g, dofs, self.V.sub(comp))
+            bcs.append(bc)
+            self.lifting_bcs.append(bc)
+            self._prescribed_values.append((g, dofs[1], motion))
+        return bcs
+
+    def constraint_dofs(self) -> list[tuple[np.ndarray, float, object]]:
+        """[(local unrolled dofs of V, value, amplitude)]: supports (value 0) and prescribed motion
+        (value·λ or value·amplitude(λ); a general motion as value 1 and amplitude λ ↦ motion(λ))."""
+        out = [(blocks * self.ndof + comp, 0.0, None) for blocks, comps in self._bcs for comp in comps]
+        for entities, comp, motion in self._prescribed:
+            blocks = dolfinx.fem.locate_dofs_topological(self.V, *entities)
+            if motion.function is None:
+                out.append((blocks * self.ndof + comp, motion.value, motion.amplitude))
+            else:
+                out.append((blocks * self.ndof + comp, 1.0, lambda lam, m=motion: m(lam, self.stage)))
+        return out
+
+    def external_force(self, b: PETSc.Vec, amplitude=None) -> None:
+        """Add the loads with the given amplitude (None: those proportional to λ) at unit factor."""
+        self._add_distributed_loads(b, amplitude)
+        n_owned = self.V.dofmap.index_map.size_local
+        with b.localForm() as bl:
+            arr = bl.array.reshape(-1, self.ndof)
+            for blocks, values, amp in self._point_loads:
+                if amp is amplitude:
+                    arr[blocks[blocks < n_owned], : len(values)] += values
+
+    def _add_distributed_loads(self, b: PETSc.Vec, amplitude) -> None:
+        """Tractions and body forces (solids); none by default."""
+
+    # -- read-out -------------------------------------------------------------------
+    def translations_of(self, blocks: np.ndarray) -> np.ndarray:
+        """(len(blocks), gdim) displacements of the given local blocks."""
+        return self.state.x.array.reshape(-1, self.state_size)[blocks, : self.gdim]
+
+    @staticmethod
+    def _dof_values(s: np.ndarray) -> np.ndarray:
+        """The dof values (displacements, rotation vector) of one node's state."""
+        return s
+
+    def reaction(self, where: str, values: np.ndarray) -> np.ndarray:
+        """Sum over the nodes of ``where`` of an assembled nodal vector given as local array of V (all ranks)."""
+        blocks = self.owned_blocks(where)
+        local = values.reshape(-1, self.ndof)[blocks].sum(axis=0) if len(blocks) else np.zeros(self.ndof)
+        return global_sum(self.comm, np.asarray(local, dtype=float))
+
+    def nodal_values(self, where: str) -> np.ndarray:
+        """Values of the dofs of the first node of group ``where``, identical on every rank."""
+        blocks = owned_dofs_of_vertices(self.V, self.tmesh.vertices(where))
+        local = np.zeros(self.ndof + 1)
+        if len(blocks):
+            local[: self.ndof] = self._dof_values(self.state.x.array.reshape(-1, self.state_size)[blocks[0]])
+            local[self.ndof] = 1.0
+        for v in self.comm.allgather(local):
+            if v[self.ndof] == 1.0:
+                return v[: self.ndof].copy()
+        raise ValueError(f"group '{where}' has no node")
+
+    def nodes(self) -> tuple[np.ndarray, np.ndarray]:
+        """(X (n, gdim) initial positions, state (n, state_size)) of all nodes, on every rank."""
+        n_owned = self.V.dofmap.index_map.size_local
+        X = self.V.tabulate_dof_coordinates()[:n_owned, : self.gdim]
+        state = self.state.x.array.reshape(-1, self.state_size)[:n_owned]
+        return np.concatenate(self.comm.allgather(X)), np.concatenate(self.comm.allgather(state))
+
+    def surface(self, where: str) -> Surface:
+        """The contact surface of group ``where`` (parts that have none refuse)."""
+        raise SurfaceError(f"contact surface '{where}': {self.kind_name} parts in {self.gdim}D are not supported "
+                           "as contact surfaces so far (2D solids and 2D beams are)")
+
+    # -- state ----------------------------------------------------------------------
+    def checkpoint(self) -> np.ndarray:
+        return self.state.x.array.copy()
+
+    def restore(self, cp: np.ndarray) -> None:
+        self.state.x.array[:] = cp
+
+    def node_keys(self) -> np.ndarray:
+        """Input (gmsh) node number of every local block of V (owned and ghost): nodes of meshes
+        with the same ``node_source`` and the same key are one node of a coupled system."""
+        mesh = self.V.mesh
+        ids = np.empty(self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts, dtype=np.int64)
+        geo = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)
+        ids[self.V.dofmap.list.array] = geo[mesh.geometry.dofmap.array]
+        return ids
+
+    def to_global(self, local: np.ndarray) -> np.ndarray | None:
+        """Gather a local nodal array (blocks, k) to rank 0, ordered by input node number."""
+        n_owned = self.V.dofmap.index_map.size_local
+        nblocks = n_owned + self.V.dofmap.index_map.num_ghosts
+        local = np.asarray(local).reshape(nblocks, -1)
+        ids = self.comm.gather(self.node_keys()[:n_owned], root=0)
+        vals = self.comm.gather(local[:n_owned], root=0)
+        if self.comm.rank != 0:
+            return None
+        out = np.empty((sum(len(i) for i in ids), local.shape[1]))
+        for i, v in zip(ids, vals):
+            out[i] = v
+        return out
+
+    def from_global(self, values: np.ndarray) -> np.ndarray:
+        """Local flat array (owned and ghost blocks) from a node-ordered global (n, k) array."""
+        if values.shape[0] != self.V.dofmap.index_map.size_global:
+            raise ValueError(f"the checkpoint holds {values.shape[0]} nodes; this model has "
+                             f"{self.V.dofmap.index_map.size_global}: it was written for another mesh")
+        return values[self.node_keys()].ravel()
+
+    # -- description ------------------------------------------------------------------
+    def _geometry_hash(self) -> str:
+        """SHA-256 of the mesh's node coordinates in input order (the same for any partition)."""
+        geo = self.V.mesh.geometry
+        ids = np.asarray(geo.input_global_indices, dtype=np.int64)
+        nodes = self.comm.gather((ids, geo.x[: len(ids), : self.gdim]), root=0)
+        digest = None
+        if self.comm.rank == 0:
+            allids = np.concatenate([i for i, _ in nodes])
+            allx = np.concatenate([x for _, x in nodes])
+            order = np.unique(allids, return_index=True)[1]
+            digest = hashlib.sha256(np.ascontiguousarray(allx[order]).tobytes()).hexdigest()
+        return self.comm.bcast(digest, root=0)
+
+    def _materials(self) -> list:
+        """What the part's elements are made of (for the fingerprint); subclasses add to it."""
+        return [(p.kind, p.name) for p in self.parts]
+
+    def describe(self) -> dict:
+        """What defines the part: kind, mesh sizes and geometry, groups, elements and materials."""
+        imap = self.V.dofmap.index_map
+        cells = self.tmesh.mesh.topology.index_map(self.tdim).size_global
+        return {"kind": type(self).__name__, "gdim": self.gdim, "nodes": imap.size_global, "cells": cells,
+                "geometry": self._geometry_hash(), "groups": sorted(self.tmesh.groups),
+                "elements": self._materials(), "large_rotations": self.large_rotations}
+
+    # -- building (scene-facing); parts that cannot carry an element kind refuse it ---------
+    def _refuse_kind(self, kind: str, where, need: str, hint: str = "") -> None:
+        cell = self.tmesh.mesh.topology.cell_name()
+        raise ValueError(f"{kind} '{where}': {need}; this mesh has {cell}s in {self.gdim}D{hint}")
+
+    def add_beam(self, where, section, material, kinematics, orientation) -> PartRef:
+        self._refuse_kind("beam", where, "beams need a mesh of lines", " (for beams on shells read the lines "
+                          "as a mesh of their own: from_gmsh(model, 3, dim=1))")
+
+    def add_truss(self, where, area, material, prestress_force) -> PartRef:
+        self._refuse_kind("truss", where, "bars need a mesh of lines")
+
+    def add_shell(self, where, E, nu, thickness, drilling, membrane) -> PartRef:
+        self._refuse_kind("shell", where, "shells need a triangle mesh in 3D (from_gmsh(model, gdim=3))")
+
+    def add_membrane(self, where, E, nu, thickness) -> PartRef:
+        self._refuse_kind("membrane", where, "membranes need a triangle or quadrilateral mesh in 3D "
+                          "(from_gmsh(model, gdim=3))")
+
+    def add_traction(self, where: str, traction: np.ndarray, amplitude=None) -> None:
+        raise ValueError(f"load '{where}': tractions act on solids; structures take forces and moments")
+
+    def add_body_force(self, where, force: np.ndarray, amplitude=None) -> None:
+        raise ValueError("gravity acts on solids (structural self-weight: point loads)")
+
+    def load_values(self, where: str, force, moment) -> np.ndarray:
+        """The nodal load vector of a force and a moment (checked), in the part's dof order."""
+        raise NotImplementedError
+
+    def effect(self) -> str:
+        """What the part assembles, in words (Scene.effects)."""
+        return self.kind_name

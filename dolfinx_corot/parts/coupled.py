@@ -1,0 +1,49 @@
+"""Part models on several meshes solved as one system."""
+from __future__ import annotations
+
+
+class Coupled:
+    """Structural models on several meshes, solved as one system (:class:`dolfinx_corot.assembly.CoupledSystem`).
+
+    Meshes of one node source (one gmsh model) share their common nodes: a
+    beam along a shell's edge or across its surface moves with it, dofs for
+    dofs. Models that share no node are still solved together (they interact
+    through supports, loads or, later, contact).
+    """
+
+    def __init__(self, models: list):
+        self.models = list(models)
+        self.large_rotations = self.models[0].large_rotations
+
+    @property
+    def comm(self):
+        return self.models[0].comm
+
+    @property
+    def symmetric_tangent(self) -> bool:
+        return all(m.symmetric_tangent for m in self.models)
+
+    @property
+    def has_prescribed_motion(self) -> bool:
+        return any(m.has_prescribed_motion for m in self.models)
+
+    @property
+    def amplitudes(self) -> list:
+        out = []
+        for m in self.models:
+            out += [a for a in m.amplitudes if a not in out]
+        return out
+
+    def extrapolate(self, older, newer, factor: float) -> None:
+        for m, o, n in zip(self.models, older, newer):
+            m.extrapolate(o, n, factor)
+
+    def checkpoint(self):
+        return tuple(m.checkpoint() for m in self.models)
+
+    def restore(self, cp) -> None:
+        for m, c in zip(self.models, cp):
+            m.restore(c)
+
+    def describe(self) -> list:
+        return [m.describe() for m in self.models]

@@ -1,0 +1,317 @@
+"""Beams and bars on 1D meshes: co-rotational kernels wrapped as DOLFINx forms.
+
+A model holds the beams and bars that live on one 1D mesh: the space of the
+Newton corrections (one block of dofs per node), the configuration as a
+DOLFINx Function, per-cell section properties as a DG0 Function, and the
+element kernels wrapped as DOLFINx forms.
+
+* :class:`Frame2D` (gdim 2): dofs (u_x, u_y, θ_z); the state holds the
+  displacements and the *total* nodal angles (SO(2) updates are additions).
+* :class:`Frame3D` (gdim 3): dofs (u_x, u_y, u_z, w_x, w_y, w_z), w spatial
+  spins; the state holds the displacements and a unit quaternion per node,
+  updated multiplicatively, q ← exp(w)∘q.
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem
+import dolfinx.la
+
+from .. import _dolfinx, rotations
+from ..elements import beam3d as law3d
+from ..elements import line2d as law2d
+from ..io.mesh import TaggedMesh
+from ..kernels import beam3d as kernels3d
+from ..kernels import line2d as kernels2d
+from .base import Part, PartRef
+from .surface import Surface, SurfaceError, gather_surface
+
+
+class LineFrame(Part):
+    """What 2D and 3D frames and shells share: cells, section properties, forms."""
+
+    tdim = 1
+    nodes_per_cell = 2
+    gdim: int
+    nprops: int
+    kernels = None
+    kind_name = "structural"
+
+    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
+        mesh = tmesh.mesh
+        if mesh.topology.dim != self.tdim or mesh.geometry.dim != self.gdim:
+            raise ValueError(f"{type(self).__name__} needs a mesh of tdim {self.tdim} in gdim {self.gdim}; got "
+                             f"tdim {mesh.topology.dim}, gdim {mesh.geometry.dim}: read the gmsh model "
+                             f"with from_gmsh(model, gdim={self.gdim})")
+        self.tmesh = tmesh
+        self.large_rotations = bool(large_rotations)
+        self.V = dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=len(self.dof_names))
+        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=self.nprops)
+        self.props = dolfinx.fem.Function(Q, name="section")
+        self._prop_blocks = Q.dofmap.list.array  # DG0: one block per cell
+        cmap = mesh.topology.index_map(self.tdim)
+        self._owner_of_cell = np.full(cmap.size_local + cmap.num_ghosts, "", dtype=object)
+        self._bending = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
+        self._element_props: list[tuple[str, list[float]]] = []
+        self._init_conditions()
+
+    # -- building -----------------------------------------------------------
+    def add_elements(self, where: str | None, props: np.ndarray, bending: bool, kind: str) -> PartRef:
+        label = f"{kind} '{where or 'all cells'}'"
+        cells = self.tmesh.cells(where)
+        taken = self._owner_of_cell[cells]
+        clash = taken[taken != ""]
+        if len(clash):
+            raise ValueError(f"{label}: its cells already belong to {clash[0]}")
+        self._check_geometry(cells, label, props)
+        self._owner_of_cell[cells] = label
+        self._bending[cells] = bending
+        values = self.props.x.array.reshape(-1, self.nprops)
+        values[self._prop_blocks[cells]] = props
+        self.props.x.scatter_forward()
+        ref = PartRef(self, where or "", kind)
+        self.parts.append(ref)
+        self._element_props.append((label, [float(v) for v in props]))
+        self._forms = None
+        return ref
+
+    def _materials(self) -> list:
+        return self._element_props
+
+    def cell_properties(self, cells: np.ndarray) -> np.ndarray:
+        """(len(cells), nprops) section properties of local cells."""
+        return self.props.x.array.reshape(-1, self.nprops)[self._prop_blocks[cells]]
+
+    def _element_vectors(self, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        x = self.tmesh.mesh.geometry.x
+        gdofs = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 2)[cells]
+        return x[gdofs[:, 0]], x[gdofs[:, 1]] - x[gdofs[:, 0]]
+
+    def _refuse(self, cells: np.ndarray, bad: np.ndarray, points: np.ndarray, message: str) -> None:
+        """Raise ValueError(message) on every rank if any rank found bad cells.
+
+        cells: the local cells checked; bad: indices into cells of the bad ones;
+        points: (len(cells), ≥gdim) a point of each cell for the message, which
+        may use {n} (number of bad cells, owned ones counted once) and {at}.
+        """
+        owned = cells[bad] < self.tmesh.mesh.topology.index_map(self.tdim).size_local
+        first = points[bad[0], : self.gdim].tolist() if len(bad) else None
+        found = self.comm.allgather((int(np.sum(owned)), first))
+        total = sum(n for n, _ in found)
+        if total or any(f is not None for _, f in found):
+            at = next(f for _, f in found if f is not None)
+            raise ValueError(message.format(n=max(total, 1), at="(" + ", ".join(f"{c:.6g}" for c in at) + ")"))
+
+    def _check_geometry(self, cells: np.ndarray, label: str, props: np.ndarray) -> None:
+        start, d = self._element_vectors(cells)
+        lengths = np.linalg.norm(d, axis=1)
+        x = self.tmesh.mesh.geometry.x
+        scale = max(float(np.ptp(x, axis=0).max()) if len(x) else 1.0, 1e-300)
+        bad = np.flatnonzero(lengths <= 1e-10 * scale)
+        self._refuse(cells, bad, start, f"{label}: {{n}} element(s) of zero length, the first at {{at}}")
+
+    def add_truss(self, where, area, material, prestress_force) -> PartRef:
+        return self.add_bars(where, material.E * area, float(prestress_force))
+
+    # -- Model protocol (assembly.System) ------------------------------------
+    def forms(self):
+        if self._forms is None:
+            cmap = self.tmesh.mesh.topology.index_map(self.tdim)
+            owned = np.flatnonzero(self._owner_of_cell[: cmap.size_local] != "").astype(np.int32)
+            all_owned = self.comm.allreduce(bool(len(owned) == cmap.size_local), op=MPI.LAND)
+            cells = None if all_owned else owned
+            self._flag = dolfinx.fem.Constant(self.V.mesh, PETSc.ScalarType(1.0 if self.large_rotations else 0.0))
+            coeffs = [self.state, self.props, *self._element_constants()]
+            L = _dolfinx.kernel_form(self.V, self.kernels.vector_kernel.address, 1, coeffs, [self._flag], cells)
+            a = _dolfinx.kernel_form(self.V, self.kernels.matrix_kernel.address, 2, coeffs, [self._flag], cells)
+            self._forms = (L, a)
+        return self._forms
+
+    def _element_constants(self) -> list:
+        """Extra per-cell coefficients the kernels read after the properties (none by default)."""
+        return []
+
+    def bending_blocks(self) -> np.ndarray:
+        """Local blocks (owned and ghost) that a bending element on this rank touches."""
+        nblocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
+        flags = np.zeros(nblocks, dtype=bool)
+        dofs = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)
+        flags[dofs[self._bending[: len(dofs)]].ravel()] = True
+        return flags
+
+    def _fixed_blocks(self) -> np.ndarray:
+        """Blocks touched by no bending element (on any rank): their rotation has no stiffness."""
+        flag = dolfinx.fem.Function(self.V)
+        flag.x.array.reshape(-1, self.ndof)[:, 0] = self.bending_blocks()
+        flag.x.scatter_reverse(dolfinx.la.ScatterMode.add)
+        flag.x.scatter_forward()
+        return np.flatnonzero(flag.x.array.reshape(-1, self.ndof)[:, 0] == 0.0).astype(np.int32)
+
+    def load_values(self, where: str, force, moment) -> np.ndarray:
+        g = self.gdim
+        nm = 1 if g == 2 else 3
+        force = np.zeros(g) if force is None else np.atleast_1d(np.asarray(force, dtype=float))
+        moment = np.zeros(nm) if moment is None else np.atleast_1d(np.asarray(moment, dtype=float))
+        if force.shape != (g,) or moment.shape != (nm,) or not (np.all(np.isfinite(force))
+                                                             and np.all(np.isfinite(moment))):
+            raise ValueError(f"load '{where}': in {g}D give force as {g} finite numbers and moment as "
+                             f"{'a number' if nm == 1 else '3 numbers'}; got force={force.tolist()}, "
+                             f"moment={moment.tolist()}")
+        return np.concatenate([force, moment])
+
+    def effect(self) -> str:
+        kinds = sorted({p.kind for p in self.parts})
+        frame = "co-rotational" if self.large_rotations else "geometrically linear"
+        return f"{' and '.join(kinds)} elements ({frame}, {self.gdim}D)"
+
+
+class Frame2D(LineFrame):
+    """Beams and bars on one 1D mesh with gdim = 2; dofs (ux, uy, rz) per node."""
+
+    gdim = 2
+    dof_names = ("ux", "uy", "rz")
+    translations = 2
+    state_size = 3
+    nprops = law2d.NPROPS
+    kernels = kernels2d
+
+    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
+        super().__init__(tmesh, large_rotations)
+        self.state = dolfinx.fem.Function(self.V, name="state")  # state and corrections share V
+
+    def add_beam(self, where, section, material, kinematics, orientation) -> PartRef:
+        GAs = material.G * section.As if kinematics == "timoshenko" else 0.0
+        return self._add(where, material.E * section.A, material.E * section.I, GAs, 0.0, "beam")
+
+    def add_bars(self, where, EA: float, N0: float) -> PartRef:
+        return self._add(where, EA, 0.0, 0.0, N0, "truss")
+
+    def _add(self, where, EA, EI, GAs, N0, kind):
+        law2d.check_props(EA, EI, GAs, f"{kind} '{where}'")
+        return self.add_elements(where, np.array([EA, EI, GAs, N0]), EI > 0.0, kind)
+
+    def update(self, dx: PETSc.Vec) -> None:
+        """Displacements add; planar rotations compose, which for SO(2) is exact addition of angles."""
+        self.state.vector.axpy(1.0, dx)
+        self.state.x.scatter_forward()
+
+    def extrapolate(self, older: np.ndarray, newer: np.ndarray, factor: float) -> None:
+        """x = newer + factor (newer − older): angles of SO(2) extrapolate linearly."""
+        self.state.x.array[:] = newer + factor * (newer - older)
+
+    def displacement_vector(self) -> PETSc.Vec:
+        return self.state.vector
+
+    def surface(self, where: str) -> Surface:
+        """The beams of line group ``where`` as a two-sided contact surface: the axis offset by half
+        the section's depth √(12 EI/EA)/2 on either side (exact for rectangles; 0 for bars)."""
+        cells = self.tmesh.cells(where)
+        cells = cells[cells < self.tmesh.mesh.topology.index_map(1).size_local]
+        seg_blocks = np.array([self.V.dofmap.cell_dofs(c) for c in cells], dtype=np.int64).reshape(-1, 2)
+        props = self.cell_properties(cells)
+        EA, EI = props[:, 0], props[:, 1]
+        half = 0.5 * np.sqrt(12.0 * EI / np.where(EA > 0.0, EA, 1.0)) * (EA > 0.0)
+        return gather_surface(self, where, seg_blocks, self.V.tabulate_dof_coordinates(), offsets=half,
+                              two_sided=True, modulus=None)
+
+
+@numba.njit(cache=True)
+def _update_quaternions(state, dx, n):
+    """state (n, 7) ← (u + du, exp(dw)∘q) for the first n nodes; dx (n, 6)."""
+    for i in range(n):
+        for k in range(3):
+            state[i, k] += dx[i, k]
+        state[i, 3:7] = rotations.quat_update(state[i, 3:7], dx[i, 3:6].copy())
+
+
+class Rotations3D:
+    """Nodal state (u, q) with multiplicative rotation updates, shared by 3D frames and surfaces."""
+
+    state_size = kernels3d.NSTATE
+
+    def _init_state(self) -> None:
+        S = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("Lagrange", 1), dim=kernels3d.NSTATE)
+        self.state = dolfinx.fem.Function(S, name="state")
+        self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, 3] = 1.0  # identity rotations
+        self._disp = dolfinx.fem.Function(self.V, name="displacement")
+
+    def update(self, dx: PETSc.Vec) -> None:
+        """u ← u + du; q ← exp(dw)∘q (multiplicative, spatial) on owned nodes; ghosts from their owners."""
+        n_owned = self.V.dofmap.index_map.size_local
+        st = self.state.x.array.reshape(-1, kernels3d.NSTATE)
+        _update_quaternions(st, dx.array_r.reshape(-1, 6), n_owned)
+        self.state.x.scatter_forward()
+
+    def extrapolate(self, older, newer, factor):
+        raise NotImplementedError("the secant predictor is not available for 3D rotations; "
+                                  "use LoadControl(extrapolate=False)")
+
+    def displacement_vector(self) -> PETSc.Vec:
+        """Displacements in the layout of the corrections (rotational entries 0), for constraints."""
+        arr = self._disp.x.array.reshape(-1, 6)
+        arr[:, :3] = self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, :3]
+        return self._disp.vector
+
+    @staticmethod
+    def _dof_values(s: np.ndarray) -> np.ndarray:
+        return np.concatenate([s[:3], rotations.rotvec_from_quat(s[3:7].copy())])
+
+    def prescribe(self, where: str, comp: int, value: float, amplitude=None, function=None) -> None:
+        if comp >= self.translations and (value != 0.0 or function is not None):
+            raise NotImplementedError(f"prescribe '{where}': non-zero rotations ({self.dof_names[comp]}) "
+                                      "cannot be prescribed in 3D; prescribe displacements or apply a moment")
+        Part.prescribe(self, where, comp, value, amplitude, function)
+
+
+class Frame3D(Rotations3D, LineFrame):
+    """Beams and bars on one 1D mesh with gdim = 3; dofs (ux, uy, uz, rx, ry, rz) per node,
+    the rotational ones spatial spins composed multiplicatively with the nodal rotations."""
+
+    gdim = 3
+    dof_names = ("ux", "uy", "uz", "rx", "ry", "rz")
+    translations = 3
+    nprops = law3d.NPROPS
+    kernels = kernels3d
+    symmetric_tangent = False  # spatial spins: K is symmetric only at equilibrium under conservative loads
+
+    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
+        LineFrame.__init__(self, tmesh, large_rotations)
+        self._init_state()
+
+    def add_beam(self, where, section, material, kinematics, orientation) -> PartRef:
+        GAs = material.G * section.As if kinematics == "timoshenko" else 0.0
+        return self._add(where, {"EA": material.E * section.A, "GJ": material.G * section.torsion_constant,
+                                 "EIy": material.E * section.second_moment_y, "EIz": material.E * section.I,
+                                 "GAy": GAs, "GAz": GAs}, orientation, 0.0, "beam")
+
+    def add_bars(self, where, EA: float, N0: float) -> PartRef:
+        _, d = self._element_vectors(self.tmesh.cells(where))
+        # any vector not parallel to the bars orients their (unused) local axes
+        v = np.array([0.0, 0.0, 1.0]) if np.all(np.abs(d[:, 2]) < 0.9 * np.linalg.norm(d, axis=1)) \
+            else np.array([1.0, 0.0, 0.0])
+        return self._add(where, {"EA": EA, "GJ": 0.0, "EIy": 0.0, "EIz": 0.0, "GAy": 0.0, "GAz": 0.0}, v, N0,
+                         "truss")
+
+    def _add(self, where, values: dict, orientation, N0: float, kind: str):
+        label = f"{kind} '{where}'"
+        law3d.check_props(values, label)
+        v = np.asarray(orientation, dtype=float)
+        if v.shape != (3,) or not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0.0:
+            raise ValueError(f"{label}: orientation must be a non-zero 3-vector, got {orientation}")
+        props = np.array([values["EA"], values["GJ"], values["EIy"], values["EIz"], values["GAy"], values["GAz"],
+                          N0, *v])
+        bending = values["EIy"] > 0.0 or values["EIz"] > 0.0
+        return self.add_elements(where, props, bending, kind)
+
+    def _check_geometry(self, cells, label, props):
+        super()._check_geometry(cells, label, props)
+        start, d = self._element_vectors(cells)
+        v = props[-3:]
+        c = np.abs(d @ v) / (np.linalg.norm(d, axis=1) * np.linalg.norm(v))
+        bad = np.flatnonzero(c > 1.0 - 1e-8)
+        self._refuse(cells, bad, start, f"{label}: the orientation vector {v.tolist()} is parallel to {{n}} "
+                     "element(s), the first at {at}; choose one that fixes the local y axis")

@@ -1,0 +1,122 @@
+"""Shells and membranes on surface meshes in space: co-rotational kernels wrapped as DOLFINx forms.
+
+* :class:`Shell3D`: flat co-rotational shell triangles (OPT or CST membrane with drilling
+  rotations, DKT bending) and membrane triangles on a triangle mesh;
+* :class:`MembraneQuad`: four-node co-rotational membranes on a quadrilateral mesh.
+
+Both have 6 dofs per node (u, spatial spins) with multiplicative rotations as 3D frames,
+so that they share nodes with beams.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+import dolfinx.fem
+
+from ..elements import membrane_quad as quad_law
+from ..elements import shell_triangle as shell_law
+from ..io.mesh import TaggedMesh
+from ..kernels import membrane_quad as kernels_mq
+from ..kernels import shell3d as kernels_shell
+from .base import PartRef
+from .frame import Frame3D, LineFrame, Rotations3D
+
+
+class Surface3D(Rotations3D, LineFrame):
+    """What shells and quadrilateral membranes share: 6 dofs per node with multiplicative
+    rotations as in :class:`Frame3D`, and per-cell constants (initial frame, local coordinates,
+    local stiffness) computed once by the kernels' ``element_data_all``."""
+
+    tdim = 2
+    gdim = 3
+    dof_names = Frame3D.dof_names
+    translations = 3
+    symmetric_tangent = False
+
+    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
+        LineFrame.__init__(self, tmesh, large_rotations)
+        self._init_state()
+
+    def _element_constants(self) -> list:
+        """The kernels' per-cell constants of every cell with elements (DG0, computed once)."""
+        mesh = self.tmesh.mesh
+        n = self.kernels.NEDATA
+        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=n)
+        edata = dolfinx.fem.Function(Q, name="element_constants")
+        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, self.nodes_per_cell)]
+        props = self.cell_properties(np.arange(len(X)))
+        out = np.zeros((len(X), n))
+        self.kernels.element_data_all(X, props, self._owner_of_cell != "", out)
+        edata.x.array.reshape(-1, n)[Q.dofmap.list.array] = out
+        return [edata]
+
+
+class Shell3D(Surface3D):
+    """Flat co-rotational shell triangles on a triangle mesh in space; dofs (ux, uy, uz, rx, ry, rz)
+    per node, rotations multiplicative as in :class:`Frame3D`."""
+
+    nodes_per_cell = 3
+    nprops = shell_law.NPROPS
+    kernels = kernels_shell
+
+    def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
+        if tmesh.mesh.topology.cell_name() != "triangle":
+            raise NotImplementedError(f"shells are triangles; the mesh has {tmesh.mesh.topology.cell_name()} "
+                                      "cells (set Mesh.RecombineAll = 0 in gmsh)")
+        super().__init__(tmesh, large_rotations)
+
+    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str = "opt"):
+        label = f"shell '{where}'"
+        if not (thickness > 0.0 and np.isfinite(thickness)):
+            raise ValueError(f"{label}: thickness = {thickness} must be positive")
+        if not drilling > 0.0:
+            raise ValueError(f"{label}: the drilling factor {drilling} must be positive")
+        if membrane not in ("opt", "cst"):
+            raise ValueError(f"{label}: membrane '{membrane}' is not one of ('opt', 'cst')")
+        opt = 1.0 if membrane == "opt" else 0.0
+        return self.add_elements(where, np.array([E, nu, thickness, drilling, 1.0, opt]), True, "shell")
+
+    def add_membrane(self, where, E: float, nu: float, thickness: float):
+        if not (thickness > 0.0 and np.isfinite(thickness)):
+            raise ValueError(f"membrane '{where}': thickness = {thickness} must be positive")
+        return self.add_elements(where, np.array([E, nu, thickness, 0.0, 0.0, 0.0]), False, "membrane")
+
+    def _check_geometry(self, cells, label, props):
+        x = self.tmesh.mesh.geometry.x
+        g = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 3)[cells]
+        area = 0.5 * np.linalg.norm(np.cross(x[g[:, 1]] - x[g[:, 0]], x[g[:, 2]] - x[g[:, 0]]), axis=1)
+        scale = max(float(np.ptp(x, axis=0).max()) if len(x) else 1.0, 1e-300)
+        bad = np.flatnonzero(area <= 1e-10 * scale**2)
+        self._refuse(cells, bad, x[g[:, 0]], f"{label}: {{n}} triangle(s) of zero area, the first at {{at}}")
+
+
+class MembraneQuad(Surface3D):
+    """Four-node co-rotational membranes on a quadrilateral mesh in space; dofs (ux, uy, uz, rx,
+    ry, rz) per node like shells (so that they may share nodes with shells and beams), the
+    rotations of nodes carried by membranes alone fixed."""
+
+    nodes_per_cell = 4
+    nprops = quad_law.NPROPS
+    kernels = kernels_mq
+
+    def add_shell(self, where, E, nu, thickness, drilling, membrane) -> PartRef:
+        raise NotImplementedError(f"shell '{where}': shells are triangles; this mesh has quadrilaterals, which "
+                                  "carry membranes (add_membrane). Mesh the shell with triangles "
+                                  "(gmsh: Mesh.RecombineAll = 0)")
+
+    def add_membrane(self, where, E: float, nu: float, thickness: float):
+        quad_law.check_props(E, nu, thickness, f"membrane '{where}'")
+        return self.add_elements(where, np.array([E, nu, thickness]), False, "membrane")
+
+    def _check_geometry(self, cells, label, props):
+        x = self.tmesh.mesh.geometry.x
+        g = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 4)[cells][:, kernels_mq.CCW]
+        n = np.cross(x[g[:, 2]] - x[g[:, 0]], x[g[:, 3]] - x[g[:, 1]])
+        # convexity: each corner turns the same way about the element normal
+        ok = np.ones(len(g), dtype=bool)
+        for a in range(4):
+            e0 = x[g[:, (a + 1) % 4]] - x[g[:, a]]
+            e1 = x[g[:, (a + 2) % 4]] - x[g[:, (a + 1) % 4]]
+            ok &= np.einsum("ij,ij->i", np.cross(e0, e1), n) > 0.0
+        self._refuse(cells, np.flatnonzero(~ok), x[g[:, 0]], f"{label}: {{n}} quadrilateral(s) not convex, of zero "
+                     "area or with nodes out of order, the first at {at}")

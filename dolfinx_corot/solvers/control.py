@@ -1,0 +1,313 @@
+"""Drivers: how the load path is followed.
+
+* :class:`LoadControl` applies the load factors λ₁ < λ₂ < … in turn. With
+  prescribed displacements (``Scene.prescribe``) the same driver is
+  *displacement control*: λ scales the prescribed motion and the reactions
+  are read with ``Scene.monitor_reaction``.
+* :class:`ArcLength` follows the equilibrium path through limit points
+  (snap-through and snap-back) by Crisfield's cylindrical arc-length method.
+
+A step that fails is cut in half and retried from the exact last converged
+state (configuration, rotations, history), up to ``max_cuts`` times in a row.
+After all cuts a :class:`ConvergenceError` carries every converged step.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..result import Result
+from .newton import NewtonOptions, NewtonReport, Stepper, newton, solve_step
+from .run import CheckpointError, Run
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class LoadControl:
+    """Load factors ``load_factors`` in turn (they may decrease, to unload), or ``steps`` equal
+    steps up to ``final``.
+
+    max_cuts: successive halvings of a failing step before giving up;
+    extrapolate: start each step from the secant extrapolation of the last
+    converged increment instead of the last converged state (exact rollback
+    still restores the converged state).
+    """
+
+    steps: int = 10
+    final: float = 1.0
+    load_factors: Sequence[float] | None = None
+    max_cuts: int = 8
+    extrapolate: bool = False
+    newton: NewtonOptions = NewtonOptions()
+
+    def targets(self) -> np.ndarray:
+        """The load factors to reach in turn (any order: they may decrease, to unload)."""
+        if self.load_factors is not None:
+            lf = np.asarray(self.load_factors, dtype=float)
+        else:
+            if self.steps < 1:
+                raise ValueError(f"LoadControl: steps = {self.steps} must be at least 1")
+            lf = np.linspace(0.0, self.final, self.steps + 1)[1:]
+        if len(lf) == 0 or not np.all(np.isfinite(lf)):
+            raise ValueError("LoadControl: load factors must be finite and not empty")
+        return lf
+
+    def describe(self) -> dict:
+        return {"name": "LoadControl", "targets": self.targets().tolist(), "max_cuts": self.max_cuts,
+                "extrapolate": self.extrapolate}
+
+    def _restart_index(self, state: dict, lam: float, path: str) -> int:
+        """Where a restart continues: at the checkpoint's next target when this driver's targets
+        begin like those it had reached (the same driver, or one asking for more: a larger
+        ``final`` with the same step, more ``load_factors``); else, for monotone targets, at the
+        first one beyond the load factor reached (a smooth continuation with this driver's step);
+        anything else is refused."""
+        targets = self.targets()
+        done = int(state["next_target"])
+        old = np.asarray(state.get("targets", []), dtype=float)
+        if len(old) >= done and len(targets) >= done and np.array_equal(targets[:done], old[:done]):
+            return done
+        steps = np.diff(np.concatenate([[0.0], targets]))
+        if np.all(steps > 0.0) or np.all(steps < 0.0):
+            beyond = np.flatnonzero(np.sign(steps[0]) * (targets - lam) > 1e-14 * max(1.0, abs(lam)))
+            start = int(beyond[0]) if len(beyond) else len(targets)
+            logger.info("restart from %s at load factor %.6g: this driver's targets differ from the "
+                        "checkpoint's; continuing at %s", path, lam,
+                        f"{targets[start]:.6g}" if start < len(targets) else "its end")
+            return start
+        raise CheckpointError(f"restart from {path}: the load factors of this LoadControl differ from those of "
+                              "the checkpoint's and do not increase (or decrease) steadily, so where to go on "
+                              "is ambiguous; restart with the same driver or one that extends it")
+
+    def run(self, run: Run, restart: str | None = None) -> Result:
+        system = run.system
+        targets = self.targets()
+        start = 0
+        if restart is not None:
+            state, _ = run.load(restart, "LoadControl")
+            start = self._restart_index(state, run.load_factor, restart)
+        lam = run.load_factor
+        previous = None
+        for index in range(start, len(targets)):
+            target = targets[index]
+            cuts = 0
+            while abs(target - lam) > 1e-14 * max(1.0, abs(target)):
+                trial = target if cuts == 0 else lam + (target - lam) / 2**cuts
+                cp = system.checkpoint()
+                started = run.begin()
+                if self.extrapolate and previous is not None and lam != previous[0]:
+                    # secant predictor along the last converged increment
+                    system.extrapolate(previous[1], cp, (trial - lam) / (lam - previous[0]))
+                system.before_step()
+                report = solve_step(system, Stepper(trial), self.newton)
+                if not report.converged:
+                    system.restore(cp)
+                    cuts += 1
+                    run.cuts += 1
+                    logger.info("step %d: lambda %.6g failed (%s); cut %d", run.step + 1, trial, report.reason, cuts)
+                    if cuts > self.max_cuts:
+                        run.fail(f"step {run.step + 1}: no convergence to load factor {trial:.6g} from "
+                                 f"{lam:.6g} after {self.max_cuts} cuts; last attempt: {report.reason}. "
+                                 "Try smaller steps, or arc-length past a limit point.")
+                    continue
+                previous = (lam, cp)
+                lam = trial
+                run.record(lam, report, cuts, started)
+                reached = abs(target - lam) <= 1e-14 * max(1.0, abs(target))
+                run.save({**self.describe(), "next_target": index + 1 if reached else index})
+                cuts = max(cuts - 1, 0)
+        return run.result()
+
+
+class ArcLengthStepper(Stepper):
+    """Corrections of Crisfield's cylindrical arc-length method: K dx_t = f, K dx_r = r,
+    dx = dx_r + δλ dx_t with δλ the root of ‖Δx + dx‖² + ψ²F(Δλ + δλ)² = Δl² whose increment
+    makes the smaller angle with the current one (Crisfield 1991, §9.3–9.4)."""
+
+    check_growth = False  # the constraint, not the residual, steers the first iterations
+
+    def __init__(self, lam: float, Dlam: float, f, dxt, dxr, Dx, arc: float, psi2F: float):
+        self.lam, self.Dlam = lam, Dlam
+        self.f, self.dxt, self.dxr, self.Dx = f, dxt, dxr, Dx
+        self.arc, self.psi2F = arc, psi2F
+        self.dl = 0.0
+
+    @property
+    def load_factor(self) -> float:
+        return self.lam + self.Dlam
+
+    def correct(self, system, rhs) -> float:
+        dxt, dxr, Dx, psi2F = self.dxt, self.dxr, self.Dx, self.psi2F
+        system.solve(self.f, dxt)
+        system.solve(rhs, dxr)
+        a = dxt.dot(dxt) + psi2F
+        Dx.copy(system.dx)
+        system.dx.axpy(1.0, dxr)  # Δx + dx_r
+        b = 2.0 * (dxt.dot(system.dx) + psi2F * self.Dlam)
+        c = system.dx.dot(system.dx) + psi2F * self.Dlam**2 - self.arc**2
+        disc = b * b - 4.0 * a * c
+        if disc < 0.0:
+            # no point of the line dx_r + δλ dx_t lies on the constraint: take the
+            # closest one (Crisfield 1991, §9.4.1) and let the next iterations return
+            roots = [-b / (2 * a)]
+        else:
+            roots = [(-b + math.sqrt(disc)) / (2 * a), (-b - math.sqrt(disc)) / (2 * a)]
+        # angle with the current increment: (Δx + dx_r + δλ dx_t)·Δx + ψ²F Δλ(Δλ+δλ)
+        base = system.dx.dot(Dx)
+        tdot = dxt.dot(Dx)
+        cosines = [base + r * tdot + psi2F * self.Dlam * (self.Dlam + r) for r in roots]
+        self.dl = roots[int(np.argmax(cosines))]
+        dxr.copy(system.dx)
+        system.dx.axpy(self.dl, dxt)
+        return system.dx.norm()
+
+    def scale(self, factor: float) -> None:
+        self.dl *= factor
+
+    def trial_load_factor(self, s: float) -> float:
+        return self.lam + (self.Dlam + s * self.dl)
+
+    def accept(self, system, s: float) -> None:
+        self.Dx.axpy(s, system.dx)
+        self.Dlam = self.Dlam + s * self.dl
+
+
+@dataclass(frozen=True)
+class ArcLength:
+    """Crisfield's cylindrical arc-length method (Crisfield 1981; 1991, §9.3).
+
+    Unknowns x and λ satisfy r(x, λ) = 0 and ‖Δx‖² + ψ²Δλ²‖f_ext‖² = Δl²
+    within each step. Corrections: K dx_r = r, K dx_t = f_ext,
+    dx = dx_r + δλ dx_t with δλ a root of the constraint; the root whose
+    increment makes the smaller angle with the previous one is taken. The
+    predictor follows the sign of Δx_prev·dx_t, which passes limit points
+    and snap-backs. The predictor's load direction is the sign of det K (the
+    parity of the number of negative eigenvalues, counted by the LDLᵀ
+    factorization), so λ turns exactly at limit points; without that count it
+    follows the sign of Δx_prev·dx_t (Feng, Perić & Owen 1996). Δl adapts as
+    Δl·√(desired/used iterations), within [min_length, max_length].
+
+    initial_increment: load-factor increment of the first step (sets Δl);
+    max_steps; max_load_factor: stop when |λ| reaches it; stop: a function of
+    the history row that returns True to stop (e.g. a displacement reached);
+    psi: load term weight (0: cylindrical); max_growth: largest factor by which Δl
+    grows from one step to the next.
+    """
+
+    initial_increment: float = 0.05
+    max_steps: int = 100
+    max_load_factor: float = math.inf
+    stop: Callable[[dict], bool] | None = None
+    desired_iterations: int = 5
+    min_length: float | None = None
+    max_length: float | None = None
+    psi: float = 0.0
+    max_growth: float = 1.5
+    max_cuts: int = 8
+    newton: NewtonOptions = field(default_factory=NewtonOptions)
+
+    def describe(self) -> dict:
+        d = {k: v for k, v in asdict(self).items() if k not in ("stop", "newton")}
+        return {"name": "ArcLength", **{k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+                                        for k, v in d.items()}}
+
+    def run(self, run: Run, restart: str | None = None) -> Result:
+        """Follow the path; a restart continues with the checkpoint's arc length and direction
+        (this driver's stopping rules — ``max_steps``, ``max_load_factor``, ``stop`` — apply)."""
+        system = run.system
+        if system.has_prescribed_motion:
+            raise NotImplementedError("arc-length with prescribed displacements is not supported; "
+                                      "follow them with LoadControl (displacement control)")
+        if system.reference_load_norm == 0.0:
+            raise ValueError("arc-length needs a reference load: the scene has no loads proportional to λ")
+        if system.amplitude_loads:
+            raise NotImplementedError("arc-length follows proportional loading only; loads with an "
+                                      "amplitude are applied with LoadControl")
+        opts = self.newton
+        f = system.new_vector()
+        system.reference_load(f)
+        F = f.dot(f)
+        psi2F = self.psi**2 * F
+        dxt, dxr, Dx, Dx_prev = (system.new_vector() for _ in range(4))
+        lam = run.load_factor
+        dlam_prev = 0.0
+        have_prev = False
+        arc = None
+        arc_min = arc_max = None
+        cuts = 0
+        if restart is not None:
+            state, arrays = run.load(restart, "ArcLength")
+            arc, arc_min, arc_max = state["arc"], state["arc_min"], state["arc_max"]
+            dlam_prev, have_prev = state["dlam_prev"], state["have_prev"]
+            lam = run.load_factor
+            system.global_to_vector(arrays, "Dx_prev", Dx_prev)
+        while run.step < self.max_steps:
+            cp = system.checkpoint()
+            started = run.begin()
+            report = NewtonReport(False, 0)
+            system.before_step()
+            try:
+                # predictor along the tangent (of the converged state: contributions evaluated there)
+                system.residual(lam)
+                system.jacobian()
+                system.solve(f, dxt)
+                tnorm = math.sqrt(dxt.dot(dxt) + psi2F)
+                if arc is None:
+                    arc = abs(self.initial_increment) * tnorm
+                    arc_min = self.min_length if self.min_length is not None else 1e-6 * arc
+                    arc_max = self.max_length if self.max_length is not None else 1e3 * arc
+                neg = system.negative_eigenvalues()
+                if not have_prev:
+                    sign = math.copysign(1.0, self.initial_increment)
+                elif neg is not None:
+                    # sign(δλ) = sign(det K) (Crisfield 1991, §9.5): λ turns where an eigenvalue
+                    # of K crosses zero (a limit point), nowhere else
+                    sign = math.copysign(1.0, self.initial_increment) * (-1.0) ** neg
+                else:
+                    sign = math.copysign(1.0, dxt.dot(Dx_prev) + psi2F * dlam_prev)
+                dlam = sign * arc / tnorm
+                dxt.copy(system.dx)
+                system.dx.scale(dlam)
+                system.begin_step()
+                system.update()
+                system.dx.copy(Dx)
+                # corrections on the constraint, then (augmented-Lagrangian contact) updates of the
+                # contributions at the converged load factor, each followed by Newton at that load
+                # factor (the arc-length constraint then holds to the size of these corrections)
+                stepper = ArcLengthStepper(lam, dlam, f, dxt, dxr, Dx, arc, psi2F)
+                report = solve_step(system, stepper, opts, begin=False)
+                ok = report.converged
+                Dlam = stepper.Dlam
+            except np.linalg.LinAlgError as err:
+                ok = False
+                report.reason = str(err)
+            if not ok:
+                system.restore(cp)
+                cuts += 1
+                run.cuts += 1
+                logger.info("arc-length step %d failed (%s); cut %d", run.step + 1, report.reason, cuts)
+                if arc is None or cuts > self.max_cuts or arc / 2 < arc_min:
+                    run.fail(f"arc-length step {run.step + 1} at load factor {lam:.6g}: no convergence after "
+                             f"{cuts - 1} cuts (arc length {arc:.3e}); last attempt: {report.reason}")
+                arc /= 2
+                continue
+            lam += Dlam
+            Dx.copy(Dx_prev)
+            dlam_prev = Dlam
+            have_prev = True
+            row = run.record(lam, report, cuts, started, {"arc_length": arc})
+            cuts = 0
+            factor = math.sqrt(self.desired_iterations / max(report.iterations, 1))
+            arc = min(max(arc * min(max(factor, 0.5), self.max_growth), arc_min), arc_max)
+            run.save({**self.describe(), "arc": arc, "arc_min": arc_min, "arc_max": arc_max,
+                      "dlam_prev": dlam_prev, "have_prev": have_prev}, {"Dx_prev": Dx_prev})
+            if abs(lam) >= self.max_load_factor or (self.stop is not None and self.stop(row)):
+                break
+        for v in (f, dxt, dxr, Dx, Dx_prev):
+            v.destroy()
+        return run.result()

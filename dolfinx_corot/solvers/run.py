@@ -1,0 +1,229 @@
+"""A run of a driver on a scene: history rows, totals, failure, checkpoint files and restart.
+
+Checkpoint files (``.npz``) hold the configuration of every part and the
+state of every contribution (contact multipliers, candidate pairs) as
+partition-independent arrays, the history, the driver's position and a
+*fingerprint* of the scene: a SHA-256 of its description (mesh sizes, a hash
+of the node coordinates, groups, elements and materials of every part, the
+contact interfaces). A restart refuses a file written for another scene
+and says what differs; a file that cannot be read is refused with its name.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+import time
+import zipfile
+import zlib
+
+import numpy as np
+
+from ..assembly import System, make_system
+from ..result import History, Result
+from .newton import ConvergenceError, NewtonReport
+
+logger = logging.getLogger(__name__)
+
+FORMAT = "dolfinx_corot checkpoint 2"
+
+
+class CheckpointError(ValueError):
+    """A checkpoint file that cannot be used for a restart (unreadable, or of another scene)."""
+
+
+def fingerprint(description) -> str:
+    return hashlib.sha256(json.dumps(description, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def _first_difference(a, b, path: str = "scene") -> str | None:
+    """Where two JSON-like descriptions first differ, in words (None if equal)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        for key in sorted(set(a) | set(b)):
+            if key not in a or key not in b:
+                return f"{path}.{key} is only in the {'checkpoint' if key in a else 'current scene'}"
+            found = _first_difference(a[key], b[key], f"{path}.{key}")
+            if found:
+                return found
+        return None
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        if len(a) != len(b):
+            return f"{path} has {len(a)} entries in the checkpoint, {len(b)} now"
+        for i, (x, y) in enumerate(zip(a, b)):
+            found = _first_difference(x, y, f"{path}[{i}]")
+            if found:
+                return found
+        return None
+    if a != b:
+        return f"{path} is {a!r} in the checkpoint, {b!r} now"
+    return None
+
+
+def read_checkpoint(path: str) -> tuple[dict, dict]:
+    """(meta, arrays) of a checkpoint file, or a :class:`CheckpointError` naming the file."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            arrays = {k: data[k] for k in data.files if k != "meta"}
+    except FileNotFoundError:
+        raise CheckpointError(f"checkpoint {path}: no such file") from None
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile, zlib.error, json.JSONDecodeError) as err:
+        raise CheckpointError(f"checkpoint {path} cannot be read ({type(err).__name__}: {err}): the file is "
+                              "truncated, corrupted or not a dolfinx_corot checkpoint") from None
+    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+        raise CheckpointError(f"checkpoint {path} is not a {FORMAT} file (format: "
+                              f"{meta.get('format') if isinstance(meta, dict) else None!r})")
+    return meta, arrays
+
+
+class Run:
+    """Bookkeeping shared by the drivers: history rows, totals, failure, checkpoints."""
+
+    def __init__(self, scene, system: System, on_step, checkpoint: str | None = None):
+        self.scene = scene
+        self.system = system
+        self.on_step = on_step
+        self.checkpoint_path = checkpoint
+        self.history = History()
+        self.t_start = time.perf_counter()
+        self.cuts = 0
+        self.iterations = 0
+        self.step = 0
+        self.load_factor = 0.0
+        self._description = scene.describe()
+        self.fingerprint = fingerprint(self._description)
+        if checkpoint is not None:
+            self._check_writable(checkpoint)
+
+    def _check_writable(self, path: str) -> None:
+        """Fail before the first step if the checkpoint cannot be written."""
+        folder = os.path.dirname(os.path.abspath(path))
+        ok = True
+        if self.system.comm.rank == 0:
+            try:
+                os.makedirs(folder, exist_ok=True)
+                ok = os.access(folder, os.W_OK) and not os.path.isdir(path)
+            except OSError:
+                ok = False
+        if not self.system.comm.bcast(ok, root=0):
+            raise CheckpointError(f"checkpoint {path}: cannot write in {folder}")
+
+    def begin(self):
+        return time.perf_counter(), self.system.timings.copy()
+
+    def record(self, lam: float, report: NewtonReport, cuts: int, started, extra: dict | None = None) -> dict:
+        t0, tm0 = started
+        tm = self.system.timings
+        self.load_factor = lam
+        self.step += 1
+        self.iterations += report.iterations
+        self.system.commit()
+        row = {"step": self.step, "load_factor": lam, "iterations": report.iterations, "cuts": cuts,
+               "wall_time": time.perf_counter() - t0,
+               "time_assembly": tm.assembly - tm0.assembly, "time_solve": tm.solve - tm0.solve,
+               "time_update": tm.update - tm0.update,
+               "residuals": " ".join(f"{r:.2e}" for r in report.residuals)}
+        row.update(self.system.history(report))
+        row.update(extra or {})
+        row.update(self.scene.monitor_values(self.system))
+        self.history.append(row)
+        logger.info("step %d: lambda = %.6g, %d iterations, |r|: %s", self.step, lam, report.iterations,
+                    row["residuals"])
+        if self.on_step is not None:
+            self.on_step(row)
+        return row
+
+    def save(self, driver_state: dict, vectors: dict | None = None) -> None:
+        """Write the checkpoint (if asked for): configuration, contribution states, history,
+        driver state and the scene's fingerprint.
+
+        vectors: name → ghosted PETSc vector laid out like the solution.
+        The file is replaced atomically, so a crash never leaves it half written.
+        """
+        if self.checkpoint_path is None:
+            return
+        arrays = self.system.global_arrays(vectors or {})
+        if self.system.comm.rank == 0:
+            meta = {"format": FORMAT, "fingerprint": self.fingerprint, "scene": self._description,
+                    "large_rotations": self.scene.large_rotations, "step": self.step,
+                    "load_factor": self.load_factor, "cuts": self.cuts, "iterations": self.iterations,
+                    "history": self.history.rows, "driver": driver_state}
+            tmp = self.checkpoint_path + ".tmp"
+            with open(tmp, "wb") as f:
+                np.savez(f, meta=np.array(json.dumps(meta, default=str)), **arrays)
+            os.replace(tmp, self.checkpoint_path)
+        self.system.comm.barrier()
+
+    def load(self, path: str, driver_name: str) -> tuple[dict, dict]:
+        """Restore configuration, contribution states, history and counters from a checkpoint;
+        returns (driver state, arrays). Refuses a file of another scene or another driver."""
+        comm = self.system.comm
+        found = None
+        if comm.rank == 0:
+            try:
+                found = read_checkpoint(path)
+            except CheckpointError as err:
+                found = err
+        found = comm.bcast(found, root=0)
+        if isinstance(found, CheckpointError):
+            raise found
+        meta, arrays = found
+        if bool(meta["large_rotations"]) != self.scene.large_rotations:
+            raise CheckpointError(
+                f"the checkpoint {path} was computed with large_rotations={meta['large_rotations']}; switching "
+                "large rotations on or off at a restart is not allowed (seed §2.2): restart with the same scene")
+        if meta["fingerprint"] != self.fingerprint:
+            where = _first_difference(meta["scene"], json.loads(json.dumps(self._description, default=str)))
+            raise CheckpointError(f"the checkpoint {path} was written for another scene: {where}. A restart "
+                                  "continues the same scene (same meshes, parts, materials and interfaces)")
+        if meta["driver"].get("name") != driver_name:
+            raise CheckpointError(f"the checkpoint {path} was written by {meta['driver'].get('name')}, "
+                                  f"not {driver_name}")
+        try:
+            self.system.set_global_arrays(arrays)
+        except (KeyError, ValueError, IndexError) as err:
+            raise CheckpointError(f"checkpoint {path}: its arrays do not fit this scene ({err})") from None
+        self.step, self.load_factor = meta["step"], meta["load_factor"]
+        self.cuts, self.iterations = meta["cuts"], meta["iterations"]
+        for row in meta["history"]:
+            self.history.append(row)
+        return meta["driver"], arrays
+
+    def totals(self) -> dict:
+        return {"steps": len(self.history), "newton_iterations": self.iterations, "cuts": self.cuts,
+                "wall_time": time.perf_counter() - self.t_start}
+
+    def fail(self, msg: str):
+        raise ConvergenceError(msg, Result(self.history, False, msg, self.totals()))
+
+    def result(self, message: str = "") -> Result:
+        return Result(self.history, True, message, self.totals())
+
+
+def solve(scene, driver, system: System | None = None, on_step=None, checkpoint: str | None = None,
+          restart: str | None = None) -> Result:
+    """Run ``driver`` (LoadControl or ArcLength) on ``scene``; returns a :class:`Result`.
+
+    On a step that fails after all cuts, raises :class:`ConvergenceError`
+    whose ``result`` holds every converged step, and the configuration is
+    left at the last converged state. ``on_step(row)`` is called after every
+    converged step with its history row (e.g. to store snapshots).
+
+    checkpoint: file (``.npz``) rewritten after every converged step with the
+    configuration, the contributions' state (contact multipliers), the history,
+    the driver's state and the scene's fingerprint; restart: such a file to
+    continue from. The scene must be the same (checked by the fingerprint; switching
+    ``large_rotations`` is refused too); the driver of the same kind may ask for more
+    (a larger ``final`` or ``max_steps``): see each driver's ``run``. A restarted run
+    reproduces the uninterrupted one.
+    """
+    own_system = system is None
+    if own_system:
+        system = make_system(scene.model, solver=getattr(scene, "linear_solver", "auto"),
+                             contributions=scene.contributions())
+    try:
+        return driver.run(Run(scene, system, on_step, checkpoint), restart)
+    finally:
+        if own_system:
+            system.destroy()

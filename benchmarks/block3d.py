@@ -56,7 +56,7 @@ def main():
     tip = np.argmin(np.linalg.norm(X - np.array([10.0, 0.5, 0.5]), axis=1))
     tm_ = system.timings
     it = res.totals["newton_iterations"]
-    ksp_its = system.ksp.getIterationNumber()
+    ksp_its = system.linear.ksp.getIterationNumber()
     rss = comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, op=MPI.SUM)
     data = {"mesh": args.mesh, "degree": args.degree, "solver": args.solver, "ranks": comm.size,
             "dofs": int(scene.model.V.dofmap.index_map.size_global * 3), "steps": len(res.history),

@@ -45,7 +45,7 @@ def _linear_field_error(sc):
     its nodes — those on the interface y = 1 included — relative to max |u|, on every rank: the
     exact solution is homogeneous (linear displacements) in both blocks. The blocks are told
     apart by their cells (their interface nodes may share positions)."""
-    from dolfinx_corot.assembly import owned_dofs_of_vertices
+    from dolfinx_corot.parts import owned_dofs_of_vertices
 
     model = sc.model
     X = model.V.tabulate_dof_coordinates()[:, :2]
@@ -164,7 +164,7 @@ def test_assembled_contact_tangent_matches_finite_differences(symmetric, smooth)
     sc, _ = _patch_scene(3, 4, dc.AugmentedLagrangian(), symmetric, smooth)
     for itf in sc.interfaces:
         itf.multiplier[:] = 0.3 * P  # an augmented state
-    system = make_system(sc.model, contacts=sc.interfaces)
+    system = make_system(sc.model, contributions=sc.contributions())
     model = sc.model
     X = model.V.tabulate_dof_coordinates()
     u = model.state.x.array.reshape(-1, 2)
@@ -191,7 +191,7 @@ def test_assembled_contact_tangent_matches_finite_differences(symmetric, smooth)
     fixed = np.concatenate([bc.dof_indices()[0] for bc in system.bcs])
     free = np.setdiff1d(np.arange(n), fixed)
     sub = np.ix_(free, free)
-    assert comm.allreduce(int(system.contact.interfaces[0].active.max()), op=MPI.MAX) >= 0
+    assert comm.allreduce(int(sc.interfaces[0].active.max()), op=MPI.MAX) >= 0
     assert np.abs(K[sub] - Kfd[sub]).max() < 1e-6 * np.abs(K[sub]).max()
     system.destroy()
 
@@ -379,7 +379,7 @@ def test_a_beam_master_is_two_sided():
         law = dc.AugmentedLagrangian()
         sc.contact(slaves=(soil, "below_top"), masters=(beam, "plate"), law=law)
         sc.contact(slaves=(soil, "above_bottom"), masters=(beam, "plate"), law=law)
-        system = make_system(sc.model, contacts=sc.interfaces)
+        system = make_system(sc.model, contributions=sc.contributions())
         res = dc.solve(sc, dc.LoadControl(steps=2), system=system)
         system.destroy()
         row = res.history.rows[-1]
@@ -417,9 +417,9 @@ def test_stale_candidates_are_no_partners():
     sc = dc.Scene()
     b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
     (itf,) = sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_faces"))
-    system = make_system(sc.model, contacts=sc.interfaces)
+    system = make_system(sc.model, contributions=sc.contributions())
     xs, xm = itf._positions(itf.slave), itf._positions(itf.master)
-    seg = itf.master["segments"]
+    seg = itf.master.facets
     bottom = np.flatnonzero(xm[seg].mean(axis=1)[:, 1] < 0.5)
     assert len(bottom) == 4
     itf.anchor = (xs.copy(), xm.copy())  # no new search
@@ -455,10 +455,10 @@ def test_an_idle_interface_changes_nothing_and_builds_no_matrix():
         sc.prescribe(b, "top", ux=0.3, uy=0.5)  # the slider is moved away from the base
         if with_contact:
             sc.contact(slaves=(b, "slider_bottom"), masters=(b, "base_top"), symmetric=True)
-        system = make_system(sc.model, contacts=sc.interfaces)
+        system = make_system(sc.model, contributions=sc.contributions())
         dc.solve(sc, dc.LoadControl(steps=3), system=system)
         if with_contact:
-            assert system.contact.C is None and system.contact.time < 0.5
+            assert system.C is None and system.timings.contributions < 0.5
         results.append(sc.model.nodes()[1])
         system.destroy()
     if comm.rank == 0:
@@ -524,7 +524,7 @@ def test_beam_on_a_soil_block(direction, beam_on_soil_convergence):
     else:
         made = sc.contact(slaves=(beam, "beam"), masters=(soil, "soil_top"), law=law,
                           symmetric=direction == "symmetric")
-    system = make_system(sc.model, contacts=sc.interfaces)
+    system = make_system(sc.model, contributions=sc.contributions())
     res = dc.solve(sc, dc.LoadControl(steps=2), system=system)
     system.destroy()
     assert res.history.column("cuts").sum() == 0

@@ -151,11 +151,11 @@ def test_linear_solver_is_chosen_by_the_scene():
     sc = dc.Scene()
     sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, 0.3), degree=1)
     s = make_system(sc.model)
-    assert s.ksp.getType() == "cg" and s.ksp.getPC().getType() in ("ml", "gamg")
+    assert s.linear.ksp.getType() == "cg" and s.linear.ksp.getPC().getType() in ("ml", "gamg")
     assert s.A.getType().endswith("baij") and s.iterative
     s.destroy()
     s = make_system(sc.model, solver="direct")
-    assert s.ksp.getPC().getFactorSolverType() == "mumps"
+    assert s.linear.ksp.getPC().getFactorSolverType() == "mumps"
     s.destroy()
 
 

@@ -222,6 +222,34 @@ class Part:
         """The dof values (displacements, rotation vector) of one node's state."""
         return s
 
+    def displacement_field(self) -> dolfinx.fem.Function:
+        """The displacement as a Function with gdim components on the part's mesh (the state
+        itself for solids; a P1 copy of the state's translations for structures)."""
+        if self.state_size == self.gdim:
+            return self.state
+        if getattr(self, "_displacement_out", None) is None:
+            self._displacement_out = dolfinx.fem.Function(
+                dolfinx.fem.VectorFunctionSpace(self.V.mesh, ("Lagrange", 1), dim=self.gdim), name="displacement")
+        out = self._displacement_out
+        out.x.array.reshape(-1, self.gdim)[:] = self.state.x.array.reshape(-1, self.state_size)[:, : self.gdim]
+        return out
+
+    def rotation_field(self) -> dolfinx.fem.Function | None:
+        """The nodal rotations as a P1 Function (2D: the angle θ_z; 3D: the rotation vector, norm ≤ π),
+        or None for parts without rotations."""
+        if self.ndof == self.translations:
+            return None
+        nr = self.ndof - self.translations
+        if getattr(self, "_rotation_out", None) is None:
+            mesh = self.V.mesh
+            space = dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1)) if nr == 1 else \
+                dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=nr)
+            self._rotation_out = dolfinx.fem.Function(space, name="rotation")
+        st = self.state.x.array.reshape(-1, self.state_size)
+        values = np.array([self._dof_values(row)[self.translations:] for row in st]).reshape(len(st), nr)
+        self._rotation_out.x.array[:] = values.ravel()
+        return self._rotation_out
+
     def reaction(self, where: str, values: np.ndarray) -> np.ndarray:
         """Sum over the nodes of ``where`` of an assembled nodal vector given as local array of V (all ranks)."""
         blocks = self.owned_blocks(where)

@@ -249,3 +249,32 @@ def test_bad_input_is_named():
         sc.add_solid(tm, "block", material=dc.NeoHookean(E, 0.3))
     with pytest.raises(dc.GroupNotFoundError):
         sc.fix(b, "nowhere")
+
+
+@pytest.mark.parametrize("large_rotations", [True, False], ids=["neo-hookean", "small strain"])
+def test_reference_configuration_is_owned_by_the_solid(large_rotations):
+    """A solid whose reference is the mesh moved by a field w (X' = X + w, here X' = 2X on the unit
+    square) is the solid meshed at X' itself: the same displacements node by node (to round-off),
+    under a traction per reference area and a body force per reference volume (Nanson's formula and
+    det J₀ in the load forms)."""
+    results = []
+    for scale, shifted in ((1.0, True), (2.0, False)):
+        tm = rectangles({"block": (0.0, 0.0, scale, scale, 3, 3)},
+                        {"bottom": [("block", "bottom")], "left": [("block", "left")],
+                         "right": [("block", "right")]}, comm=comm)
+        sc = dc.Scene(large_rotations=large_rotations)
+        b = sc.add_solid(tm, material=dc.NeoHookean(E, 0.3), degree=2)
+        sc.fix(b, "bottom", dofs=("uy",))
+        sc.fix(b, "left", dofs=("ux",))
+        sc.load(b, "right", traction=(0.02 * E, 0.005 * E))
+        sc.gravity(b, (0.0, -1.0), 0.01 * E)
+        model = sc.model
+        if shifted:
+            model.capture_reference(model.V.tabulate_dof_coordinates()[:, :2].ravel())  # w = X
+        dc.solve(sc, dc.LoadControl(steps=2))
+        X, u = model.nodes()
+        ref = X * (2.0 if shifted else 1.0)
+        order = np.lexsort(np.round(ref, 9).T[::-1])
+        results.append(u[order])
+    assert np.abs(results[0]).max() > 1e-3
+    np.testing.assert_allclose(results[0], results[1], atol=1e-10 * np.abs(results[1]).max())

@@ -45,6 +45,9 @@ class Model(Protocol):
     has_prescribed_motion: bool
     amplitudes: list                                          # distinct load amplitudes (None: ∝ λ)
     large_rotations: bool
+    continuum: bool                                           # a continuum alone (AMG may solve it)
+    coupled: bool                                             # parts on several meshes (``models``)
+    lifting_bcs: list                                         # the bcs of prescribed motion
 
     def forms(self) -> tuple[object, object]: ...            # (vector form, matrix form)
     def dirichlet_bcs(self) -> list: ...                        # supports and prescribed motion
@@ -92,12 +95,12 @@ class System:
         self._mat_type = "baij" if solver == "iterative" else None
         self._build()
         self.fint, self.dx, self.step_dx, self.lift, self.fext_total, self._rhs = petsc.duplicate(self.b, 6)
-        self.has_prescribed_motion = bool(getattr(model, "has_prescribed_motion", False))
+        self.has_prescribed_motion = bool(model.has_prescribed_motion)
         self.load_factor = 0.0
         self.fext = self._external_force(None)
         self.reference_load_norm = self.fext.norm()
         # loads with their own amplitudes g(λ)
-        self.amplitude_loads = [(amp, self._external_force(amp)) for amp in getattr(model, "amplitudes", [])]
+        self.amplitude_loads = [(amp, self._external_force(amp)) for amp in model.amplitudes]
         self.timings = Timings()
         self.contributions = list(contributions)
         if self.contributions and solver == "iterative":
@@ -110,14 +113,14 @@ class System:
         self.pattern_builds = 0
         self.engaged = False
         if symmetric is None:
-            symmetric = getattr(model, "symmetric_tangent", True)
+            symmetric = model.symmetric_tangent
         self.iterative = solver == "iterative"
         nullspace = None
         if self.iterative:
             nullspace = petsc.near_nullspace(self.comm, model.V.dofmap.index_map, model.V.dofmap.index_map_bs,
                                              model.near_nullspace_modes())
         self.linear = petsc.LinearSolver(self.comm, self.A, self.iterative, symmetric, options_prefix, nullspace,
-                                         fixed_rtol=not getattr(model, "large_rotations", True))
+                                         fixed_rtol=not model.large_rotations)
 
     # -- layout (one mesh: DOLFINx's own) -------------------------------------------
     def _build(self) -> None:
@@ -170,7 +173,7 @@ class System:
             with self.lift.localForm() as f:
                 f.set(0.0)
             # supports never move (x = 0 there): only prescribed motion has a lifting
-            lifting_bcs = getattr(self.model, "lifting_bcs", self.bcs)
+            lifting_bcs = self.model.lifting_bcs
             dolfinx.fem.petsc.apply_lifting(self.lift, [self.a], bcs=[lifting_bcs], x0=[x], scale=1.0)
             self.lift.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
             self.b.axpy(1.0, self.lift)
@@ -633,11 +636,11 @@ def make_system(model, solver: str = "auto", contributions: Sequence[Contributio
     'auto': iterative for a continuum alone without contributions, direct otherwise.
     contributions: added to the parts' residual and tangent (e.g. ``scene.contributions()``).
     """
-    continuum = getattr(model, "near_nullspace_modes", None) is not None
+    continuum = model.continuum
     if solver == "auto":
         solver = "iterative" if continuum and not contributions else "direct"
     if solver == "iterative" and not continuum:
         raise NotImplementedError("the iterative solver (CG + GAMG) is for continua alone; structures and coupled "
                                   "parts use the direct solver")
-    cls = CoupledSystem if hasattr(model, "models") else System
+    cls = CoupledSystem if model.coupled else System
     return cls(model, solver=solver, contributions=contributions, **kwargs)

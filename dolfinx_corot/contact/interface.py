@@ -141,6 +141,7 @@ class Interface:
         self.first_evaluation = True
         self.had_contact = False
         self.band_used = 0
+        self._virtual = None
 
     def _global_dofs(self, surf, system) -> np.ndarray:
         """(n, gdim) global dofs of the surface's nodes' translations in ``system``, on every rank."""
@@ -464,7 +465,7 @@ class Contact(Contribution):
         """When an interface predicts pairs that are open now to be closed (see
         :meth:`Interface.evaluate`): their penalty forces at the current gaps, to be taken out of
         the next correction's right-hand side; None otherwise (all ranks agree)."""
-        virtual = [(itf, itf._virtual) for itf in self.interfaces if getattr(itf, "_virtual", None) is not None]
+        virtual = [(itf, itf._virtual) for itf in self.interfaces if itf._virtual is not None]
         if not self.comm.allreduce(sum(len(v[0]) for _, v in virtual), op=MPI.SUM):
             return None
         dofs, forces = [np.zeros((0, 10), dtype=np.int64)], [np.zeros((0, 10))]

@@ -25,7 +25,7 @@ class FieldWriter:
         model = scene.model if model is None else model
         self.parts = []
         self.path = path
-        if hasattr(model, "models"):
+        if model.coupled:
             stem, ext = os.path.splitext(path)
             self.parts = [FieldWriter(scene, f"{stem}_{i}{ext}", m) for i, m in enumerate(model.models)]
             return

@@ -87,6 +87,9 @@ class Part:
     translations: int
     state_size: int
     continuum = False          # a solid (UFL forms) rather than a structure
+    coupled = False            # one mesh (Coupled: several)
+    _displacement_out = None   # output Functions, made on first use
+    _rotation_out = None
     symmetric_tangent = True
     kind_name = "part"
 
@@ -227,7 +230,7 @@ class Part:
         itself for solids; a P1 copy of the state's translations for structures)."""
         if self.state_size == self.gdim:
             return self.state
-        if getattr(self, "_displacement_out", None) is None:
+        if self._displacement_out is None:
             self._displacement_out = dolfinx.fem.Function(
                 dolfinx.fem.VectorFunctionSpace(self.V.mesh, ("Lagrange", 1), dim=self.gdim), name="displacement")
         out = self._displacement_out
@@ -240,7 +243,7 @@ class Part:
         if self.ndof == self.translations:
             return None
         nr = self.ndof - self.translations
-        if getattr(self, "_rotation_out", None) is None:
+        if self._rotation_out is None:
             mesh = self.V.mesh
             space = dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1)) if nr == 1 else \
                 dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=nr)

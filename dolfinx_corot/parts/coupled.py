@@ -11,6 +11,9 @@ class Coupled:
     through supports, loads or, later, contact).
     """
 
+    coupled = True
+    continuum = False
+
     def __init__(self, models: list):
         self.models = list(models)
         self.large_rotations = self.models[0].large_rotations

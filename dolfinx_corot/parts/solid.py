@@ -69,7 +69,7 @@ class Solid(Part):
         self.nodes_per_cell = self.V.dofmap.dof_layout.num_dofs  # dof blocks per cell
         self.state = dolfinx.fem.Function(self.V, name="displacement")
         self.reference_shift = dolfinx.fem.Function(self.V, name="reference_shift")
-        self._shifted = False
+        self._shifted = None
         Q = dolfinx.fem.FunctionSpace(mesh, ("DG", 0))
         self.E = dolfinx.fem.Function(Q, name="E")
         self.nu = dolfinx.fem.Function(Q, name="nu")
@@ -81,6 +81,7 @@ class Solid(Part):
         self._tractions: list[tuple[str, np.ndarray, object]] = []
         self._body: list[tuple[str | None, np.ndarray, object]] = []
         self._init_conditions()
+        self._shifted = False
 
     # -- building -------------------------------------------------------------
     def add_region(self, where: str | None, material: Elastic):
@@ -148,7 +149,7 @@ class Solid(Part):
         """Take the mesh moved by ``shift`` (local array of V, owned and ghost; None: the current
         displacement) as the stress-free reference of the elements, and zero the displacement.
         At creation the reference is the mesh itself."""
-        if not hasattr(self, "reference_shift"):  # the base's call at creation: the mesh
+        if self._shifted is None:  # the base's call at creation: the mesh
             return Part.capture_reference(self)
         values = self.state.x.array if shift is None else np.asarray(shift)
         self.reference_shift.x.array[:] += values
@@ -189,28 +190,39 @@ class Solid(Part):
             self._check_complete()
             u, v, du = self.state, ufl.TestFunction(self.V), ufl.TrialFunction(self.V)
             dx = ufl.dx(metadata={"quadrature_degree": self.quadrature})
+            integrand = ufl.inner(self.stress(u), self._gradient(v))
             if self._shifted:
-                dx = ufl.det(ufl.Identity(self.gdim) + ufl.grad(self.reference_shift)) * dx
-            residual = ufl.inner(self.stress(u), self._gradient(v)) * dx
+                integrand = ufl.det(ufl.Identity(self.gdim) + ufl.grad(self.reference_shift)) * integrand
+            residual = integrand * dx
             jacobian = ufl.derivative(residual, u, du)
             self._forms = (dolfinx.fem.form(residual), dolfinx.fem.form(jacobian))
         return self._forms
 
     def _load_form(self, amplitude):
-        """Linear form of the tractions and body forces of one amplitude at unit factor (or None)."""
+        """Linear form of the tractions (per reference area) and body forces (per reference volume)
+        of one amplitude at unit factor (or None). With a reference shift w the reference measures
+        are dX' = det J₀ dX and dA' = |det J₀ J₀⁻ᵀ N| dA (Nanson), J₀ = I + ∇w."""
         v = ufl.TestFunction(self.V)
+        volume = area = None
+        if self._shifted:
+            J0 = ufl.Identity(self.gdim) + ufl.grad(self.reference_shift)
+            volume = ufl.det(J0)
+            area = ufl.sqrt(ufl.dot(ufl.dot(ufl.inv(J0).T, ufl.FacetNormal(self.V.mesh)),
+                                    ufl.dot(ufl.inv(J0).T, ufl.FacetNormal(self.V.mesh)))) * volume
         terms = []
         if any(a is amplitude for *_, a in self._tractions):
             ds = ufl.Measure("ds", domain=self.V.mesh, subdomain_data=self.tmesh.facet_tags)
             for where, t, amp in self._tractions:
                 if amp is amplitude:
                     tag = self.tmesh.groups[where][1]
-                    terms.append(ufl.inner(ufl.as_vector([float(c) for c in t]), v) * ds(tag))
+                    term = ufl.inner(ufl.as_vector([float(c) for c in t]), v)
+                    terms.append((term if area is None else area * term) * ds(tag))
         dx = ufl.Measure("dx", domain=self.V.mesh, subdomain_data=self.tmesh.cell_tags)
         for where, b, amp in self._body:
             if amp is amplitude:
                 measure = dx if where is None else dx(self.tmesh.groups[where][1])
-                terms.append(ufl.inner(ufl.as_vector([float(c) for c in b]), v) * measure)
+                term = ufl.inner(ufl.as_vector([float(c) for c in b]), v)
+                terms.append((term if volume is None else volume * term) * measure)
         if not terms:
             return None
         return dolfinx.fem.form(sum(terms[1:], terms[0]))

@@ -74,6 +74,22 @@ def finite_vector(label: str, name: str, value, n: int) -> np.ndarray:
     return value
 
 
+class AdditiveState:
+    """A state that is the dofs themselves (displacements; planar angles): updates add."""
+
+    def update(self, dx: PETSc.Vec) -> None:
+        """x ← x + dx (SO(2) rotations compose by adding angles)."""
+        self.state.vector.axpy(1.0, dx)
+        self.state.x.scatter_forward()
+
+    def extrapolate(self, older: np.ndarray, newer: np.ndarray, factor: float) -> None:
+        """x = newer + factor (newer − older)."""
+        self.state.x.array[:] = newer + factor * (newer - older)
+
+    def displacement_vector(self) -> PETSc.Vec:
+        return self.state.vector
+
+
 class Part:
     """Base of every part model (see the module docstring).
 
@@ -299,12 +315,16 @@ class Part:
         ids[self.V.dofmap.list.array] = geo[mesh.geometry.dofmap.array]
         return ids
 
+    def _global_index(self) -> np.ndarray:
+        """Position of each owned block in the partition-independent order of checkpoint files."""
+        return self.node_keys()[: self.V.dofmap.index_map.size_local]
+
     def to_global(self, local: np.ndarray) -> np.ndarray | None:
-        """Gather a local nodal array (blocks, k) to rank 0, ordered by input node number."""
+        """Gather a local nodal array (blocks, k) to rank 0, in the order of :meth:`_global_index`."""
         n_owned = self.V.dofmap.index_map.size_local
         nblocks = n_owned + self.V.dofmap.index_map.num_ghosts
         local = np.asarray(local).reshape(nblocks, -1)
-        ids = self.comm.gather(self.node_keys()[:n_owned], root=0)
+        ids = self.comm.gather(self._global_index(), root=0)
         vals = self.comm.gather(local[:n_owned], root=0)
         if self.comm.rank != 0:
             return None

@@ -27,7 +27,7 @@ from ..elements import line2d as law2d
 from ..io.mesh import TaggedMesh
 from ..kernels import beam3d as kernels3d
 from ..kernels import line2d as kernels2d
-from .base import Part, PartRef
+from .base import AdditiveState, Part, PartRef
 from .surface import Surface, SurfaceError, gather_surface
 
 
@@ -169,7 +169,7 @@ class LineFrame(Part):
         return f"{' and '.join(kinds)} elements ({frame}, {self.gdim}D)"
 
 
-class Frame2D(LineFrame):
+class Frame2D(AdditiveState, LineFrame):
     """Beams and bars on one 1D mesh with gdim = 2; dofs (ux, uy, rz) per node."""
 
     gdim = 2
@@ -193,18 +193,6 @@ class Frame2D(LineFrame):
     def _add(self, where, EA, EI, GAs, N0, kind):
         law2d.check_props(EA, EI, GAs, f"{kind} '{where}'")
         return self.add_elements(where, np.array([EA, EI, GAs, N0]), EI > 0.0, kind)
-
-    def update(self, dx: PETSc.Vec) -> None:
-        """Displacements add; planar rotations compose, which for SO(2) is exact addition of angles."""
-        self.state.vector.axpy(1.0, dx)
-        self.state.x.scatter_forward()
-
-    def extrapolate(self, older: np.ndarray, newer: np.ndarray, factor: float) -> None:
-        """x = newer + factor (newer − older): angles of SO(2) extrapolate linearly."""
-        self.state.x.array[:] = newer + factor * (newer - older)
-
-    def displacement_vector(self) -> PETSc.Vec:
-        return self.state.vector
 
     def surface(self, where: str) -> Surface:
         """The beams of line group ``where`` as a two-sided contact surface: the axis offset by half

@@ -35,13 +35,13 @@ from ..continuum.kinematics import deformation_gradient
 from ..continuum.laws import first_piola, lame
 from ..io.mesh import TaggedMesh
 from ..materials import Elastic
-from .base import Part, PartRef, finite_vector
+from .base import AdditiveState, Part, PartRef, finite_vector
 from .surface import Surface, SurfaceError, gather_surface
 
 CELLS = ("triangle", "quadrilateral", "tetrahedron", "hexahedron")
 
 
-class Solid(Part):
+class Solid(AdditiveState, Part):
     """A large-deformation continuum on one mesh (see the module docstring)."""
 
     symmetric_tangent = True  # hyperelastic, dead loads
@@ -261,16 +261,6 @@ class Solid(Part):
         return modes
 
     # -- state ---------------------------------------------------------------------
-    def update(self, dx: PETSc.Vec) -> None:
-        self.state.vector.axpy(1.0, dx)
-        self.state.x.scatter_forward()
-
-    def extrapolate(self, older: np.ndarray, newer: np.ndarray, factor: float) -> None:
-        self.state.x.array[:] = newer + factor * (newer - older)
-
-    def displacement_vector(self) -> PETSc.Vec:
-        return self.state.vector
-
     def node_keys(self) -> np.ndarray:
         """A key per local dof block (owned and ghost) for :class:`~dolfinx_corot.assembly.DofLayout`:
         the input (gmsh) node number on linear meshes, so that structures read from the same gmsh
@@ -281,8 +271,9 @@ class Solid(Part):
         n = imap.size_local + imap.num_ghosts
         return imap.local_to_global(np.arange(n, dtype=np.int32)).astype(np.int64) + (np.int64(1) << 32)
 
-    def _global_order(self) -> tuple[np.ndarray, np.ndarray]:
-        """(coordinates of owned blocks, their rank in a partition-independent ordering) on every rank."""
+    def _global_order(self) -> np.ndarray:
+        """Rank of each owned block in a partition-independent ordering (by coordinates: the
+        blocks of a quadratic solid have no input node number)."""
         n_owned = self.V.dofmap.index_map.size_local
         x = self.V.tabulate_dof_coordinates()[:n_owned]
         allx = np.concatenate(self.comm.allgather(x))
@@ -290,24 +281,15 @@ class Solid(Part):
         rank_of = np.empty(len(allx), dtype=np.int64)
         rank_of[order] = np.arange(len(allx))
         offset = sum(self.comm.allgather(n_owned)[: self.comm.rank])
-        return x, rank_of[offset: offset + n_owned]
+        return rank_of[offset: offset + n_owned]
 
-    def to_global(self, local: np.ndarray) -> np.ndarray | None:
-        n_owned = self.V.dofmap.index_map.size_local
-        _, idx = self._global_order()
-        vals = self.comm.gather((idx, np.asarray(local).reshape(-1, self.ndof)[:n_owned]), root=0)
-        if self.comm.rank != 0:
-            return None
-        out = np.empty((sum(len(i) for i, _ in vals), self.ndof))
-        for i, v in vals:
-            out[i] = v
-        return out
+    _global_index = _global_order
 
     def from_global(self, values: np.ndarray) -> np.ndarray:
         if values.shape[0] != self.V.dofmap.index_map.size_global:
             raise ValueError(f"the checkpoint holds {values.shape[0]} nodes; this solid has "
                              f"{self.V.dofmap.index_map.size_global}: it was written for another mesh")
-        _, idx = self._global_order()
+        idx = self._global_order()
         n_owned = self.V.dofmap.index_map.size_local
         out = np.zeros((n_owned + self.V.dofmap.index_map.num_ghosts, self.ndof))
         out[:n_owned] = values[idx]

@@ -25,7 +25,7 @@ from dolfinx_corot.io import from_arrays, output_dir
 
 comm = MPI.COMM_WORLD
 logging.basicConfig(level=logging.WARNING)
-logging.getLogger("dolfinx_corot.solvers.drivers").setLevel(logging.INFO)
+logging.getLogger("dolfinx_corot.solvers.control").setLevel(logging.INFO)
 
 
 def say(*a):

@@ -220,7 +220,7 @@ def solve(scene, driver, system: System | None = None, on_step=None, checkpoint:
     """
     own_system = system is None
     if own_system:
-        system = make_system(scene.model, solver=getattr(scene, "linear_solver", "auto"),
+        system = make_system(scene.model, solver=scene.linear_solver,
                              contributions=scene.contributions())
     try:
         return driver.run(Run(scene, system, on_step, checkpoint), restart)

@@ -18,36 +18,27 @@
 # `reference/B2c_45deg_bend.json` (scaled version).
 
 # %%
-import json
 import logging
-import os
-import time
 
 import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
-from dolfinx_corot.io import output_dir, reference
+from dolfinx_corot.gallery import Demo, timed
+from dolfinx_corot.io import reference
 from dolfinx_corot.io.gmsh_models import polyline
 
 comm = MPI.COMM_WORLD
-logging.basicConfig(level=logging.WARNING)
-out = output_dir("curved_beam_3d")
-
-
-def say(*args):
-    if comm.rank == 0:
-        print(*args, flush=True)
-
+B2C = "B2c exact Kirchhoff rod, Saint-Venant J (reference/B2c_45deg_bend.json, scaled version)"
 
 ref = reference("B2c_45deg_bend")
 scaled = ref["scaled_version"]
 exact = np.array(scaled["exact"]["Kirchhoff_JsaintVenant"]["data"])  # P, x, y, z, ux, uy, uz
+ex = exact[1:, 4:7]
 R, E, nu = 100.0, 5e7, 0.2
 J = scaled["exact"]["Kirchhoff_JsaintVenant"]["props"]["J"]
 EI = E / 12.0
 F = 7 * EI / R**2
-say(f"F = 7EI/R² = {F:.1f}, J = {J}")
 
 
 def bend(n):
@@ -67,53 +58,47 @@ def bend(n):
 # ## Eight elements, ten load steps (fields for ParaView in `bend.xdmf`)
 
 # %%
-scene = bend(8)
-t0 = time.perf_counter()
-# the deformed bend at every step, for ParaView (Warp By Vector on "displacement")
-with dc.io.FieldWriter(scene, os.path.join(out, "bend.xdmf")) as writer:
-    result = dc.solve(scene, dc.LoadControl(steps=10), on_step=writer)
-wall = time.perf_counter() - t0
-hist = result.history
-if comm.rank == 0:
-    result.write(out)
-u = np.c_[hist.column("tip_ux"), hist.column("tip_uy"), hist.column("tip_uz")]
-lam = hist.column("load_factor")
-ex = exact[1:, 4:7]
-err = np.linalg.norm(u - ex, axis=1) / np.linalg.norm(ex, axis=1)
-say(f"{len(hist)} steps, {result.totals['newton_iterations']} Newton iterations, {wall:.2f} s")
-say(f"tip displacement at F: ({u[-1, 0]:.3f}, {u[-1, 1]:.3f}, {u[-1, 2]:.3f}); exact rod "
-    f"({ex[-1, 0]:.3f}, {ex[-1, 1]:.3f}, {ex[-1, 2]:.3f}); relative error {err[-1]:.2e}")
-say(f"as the seed lists it (|uy|, ux, uz): ({abs(u[-1, 1]):.1f}, {u[-1, 0]:.1f}, {u[-1, 2]:.1f}); "
-    "seed reference (13.5, -23.6, 54.0), Z_Soil (13.5, -23.6, 53.3)")
+def eight_elements(demo):
+    """The history of the 8-element bend and the relative tip error at every step."""
+    scene = bend(8)
+    # the deformed bend at every step, for ParaView (Warp By Vector on "displacement")
+    with dc.io.FieldWriter(scene, demo.path("bend.xdmf")) as writer:
+        result, wall = timed(dc.solve, scene, dc.LoadControl(steps=10), on_step=writer)
+    hist = result.history
+    demo.write_result(result)
+    u = np.c_[hist.column("tip_ux"), hist.column("tip_uy"), hist.column("tip_uz")]
+    err = np.linalg.norm(u - ex, axis=1) / np.linalg.norm(ex, axis=1)
+    demo.say(f"{len(hist)} steps, {result.totals['newton_iterations']} Newton iterations, {wall:.2f} s")
+    demo.say(f"tip displacement at F: ({u[-1, 0]:.3f}, {u[-1, 1]:.3f}, {u[-1, 2]:.3f}); exact rod "
+             f"({ex[-1, 0]:.3f}, {ex[-1, 1]:.3f}, {ex[-1, 2]:.3f}); relative error {err[-1]:.2e}")
+    demo.say(f"as the seed lists it (|uy|, ux, uz): ({abs(u[-1, 1]):.1f}, {u[-1, 0]:.1f}, {u[-1, 2]:.1f}); "
+             "seed reference (13.5, -23.6, 54.0), Z_Soil (13.5, -23.6, 53.3)")
+    demo.record(load_factor=hist.column("load_factor"), ux=u[:, 0], uy=u[:, 1], uz=u[:, 2])
+    return hist, err
+
 
 # %% [markdown]
 # ## Accuracy against time: 4 to 32 elements
 
 # %%
-study = []
-for n in ([4, 8, 16] if os.environ.get("CI") == "true" else [4, 8, 16, 32]):
-    sc = bend(n)
-    t0 = time.perf_counter()
-    r = dc.solve(sc, dc.LoadControl(steps=10))
-    dt = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
-    un = np.array([r.history.column(c)[-1] for c in ("tip_ux", "tip_uy", "tip_uz")])
-    e = np.linalg.norm(un - ex[-1]) / np.linalg.norm(ex[-1])
-    study.append((n, e, dt, r.totals["newton_iterations"]))
-    say(f"{n:3d} elements: tip error {e:.2e}, {dt:.2f} s, {r.totals['newton_iterations']} iterations")
-study = np.array(study)
+def work_precision(demo, hist):
+    """(elements, tip error at F, wall time, Newton iterations) per mesh; the plot."""
+    study = []
+    for n in ([4, 8, 16] if demo.ci else [4, 8, 16, 32]):
+        sc = bend(n)
+        r, dt = timed(dc.solve, sc, dc.LoadControl(steps=10))
+        un = np.array([r.history.column(c)[-1] for c in ("tip_ux", "tip_uy", "tip_uz")])
+        e = np.linalg.norm(un - ex[-1]) / np.linalg.norm(ex[-1])
+        study.append((n, e, dt, r.totals["newton_iterations"]))
+        demo.say(f"{n:3d} elements: tip error {e:.2e}, {dt:.2f} s, {r.totals['newton_iterations']} iterations")
+    study = np.array(study)
 
-if comm.rank == 0:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    np.savetxt(os.path.join(out, "work_precision.csv"), study, delimiter=",",
-               header="elements,tip_rel_error,wall_time_s,newton_iterations", comments="")
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
-    for k, name in enumerate(("$u_x$", "$u_y$", "$u_z$")):
+    demo.table("work_precision.csv", study, ["elements", "tip_rel_error", "wall_time_s", "newton_iterations"])
+    fig, ax = demo.figure(1, 2, figsize=(11, 4.2))
+    lam = hist.column("load_factor")
+    for k, (name, c) in enumerate((("$u_x$", "tip_ux"), ("$u_y$", "tip_uy"), ("$u_z$", "tip_uz"))):
         ax[0].plot(exact[:, 0], exact[:, 4 + k], "k-", lw=0.8)
-        ax[0].plot(lam * F, u[:, k], "o", ms=4, label=f"{name}, 8 co-rotational beams")
+        ax[0].plot(lam * F, hist.column(c), "o", ms=4, label=f"{name}, 8 co-rotational beams")
     ax[0].set_xlabel("tip force F")
     ax[0].set_ylabel("tip displacement")
     ax[0].set_title("45° bend (lines: exact Kirchhoff rod)")
@@ -124,18 +109,28 @@ if comm.rank == 0:
     ax[1].set_xlabel("wall time [s] (10 load steps)")
     ax[1].set_ylabel("relative tip error at F")
     ax[1].set_title("work-precision (elements labelled)")
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "curved_beam_3d.png"), dpi=120)
-    plt.close(fig)
-    with open(os.path.join(out, "tip_values.json"), "w") as f:
-        json.dump({"load_factor": lam.tolist(), "ux": u[:, 0].tolist(), "uy": u[:, 1].tolist(),
-                   "uz": u[:, 2].tolist(), "ranks": comm.size}, f)
+    demo.save(fig, "curved_beam_3d.png")
+    return study
+
 
 # %% [markdown]
 # ## Verification
 
 # %%
-assert err.max() < 0.01, err  # acceptance: within 1 % of the exact rod with 8 elements
-assert hist.column("iterations").max() <= 6
-assert study[-1, 1] < study[0, 1] / 10  # refinement converges to the rod
-say("curved_beam_3d: verified")
+def main() -> dict:
+    demo = Demo("curved_beam_3d")
+    demo.say(f"F = 7EI/R² = {F:.1f}, J = {J}")
+    hist, err = eight_elements(demo)
+    study = work_precision(demo, hist)
+    demo.check("relative tip error, 8 elements, every load step (acceptance 1 %)", err.max(), bound=0.01,
+               reference=B2C)
+    demo.check("Newton iterations per step", hist.column("iterations").max(), bound=6,
+               reference="solver acceptance (no published value)")
+    demo.check("tip error at F, finest mesh / coarsest mesh (refinement converges to the rod)",
+               study[-1, 1] / study[0, 1], bound=0.1, reference=B2C)
+    return demo.finish()
+
+
+if __name__ == "__main__":
+    logging.basicConfig(level=logging.WARNING)
+    main()

@@ -27,31 +27,24 @@
 # matters: the same three meshes are run with the OPT membrane (the default)
 # and with the constant-strain triangle plus a drilling penalty. Both
 # converge to the same curve, OPT from below and several times faster (the
-# CST locks in in-plane bending and converges from above).
+# CST locks in in-plane bending and converges from above). The published
+# curves of this benchmark are not checked here: the checks are
+# self-convergence.
 
 # %%
-import json
 import logging
-import os
-import time
 
 import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
-from dolfinx_corot.io import output_dir
+from dolfinx_corot.gallery import Demo, timed
 from dolfinx_corot.io.gmsh_models import cylinder_eighth
 
 comm = MPI.COMM_WORLD
-logging.basicConfig(level=logging.WARNING)
-out = output_dir("cylinder_pullout")
+SELF = "self-convergence on three meshes (no published value)"
 R, L, t, E, nu = 4.953, 10.35, 0.094, 10.5e6, 0.3125
 P_end = 40000.0
-
-
-def say(*args):
-    if comm.rank == 0:
-        print(*args, flush=True)
 
 
 def pullout(n_theta, n_x, w_max=3.0, steps=30, membrane="opt"):
@@ -65,9 +58,7 @@ def pullout(n_theta, n_x, w_max=3.0, steps=30, membrane="opt"):
     scene.monitor_reaction("A", shell, "A")
     for name in "ABC":
         scene.monitor(name, shell, name)
-    t0 = time.perf_counter()
-    res = dc.solve(scene, dc.LoadControl(steps=steps))
-    wall = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    res, wall = timed(dc.solve, scene, dc.LoadControl(steps=steps))
     h = res.history
     curve = np.c_[4.0 * h.column("A_Fz"), h.column("A_uz"), h.column("B_uz"), h.column("C_uy")]
     return curve, res, wall
@@ -86,67 +77,81 @@ def at_wA(curve, w):
 # ## Three meshes (n_θ × n_x triangles pairs)
 
 # %%
-meshes = [(8, 12), (12, 18), (16, 24)] if os.environ.get("CI") == "true" else [(8, 12), (16, 24), (24, 36)]
-studies, curves = {}, {}
-for membrane in ("opt", "cst"):
-    rows = []
-    for n_theta, n_x in meshes:
-        curve, res, wall = pullout(n_theta, n_x, membrane=membrane)
-        if membrane == "opt":
-            curves[(n_theta, n_x)] = curve
-        d = at_wA(curve, W_CHECK)
-        rows.append((n_theta, n_x, *d, wall, res.totals["newton_iterations"], res.totals["cuts"], curve[-1, 0]))
-        say(f"{membrane.upper():3s} {n_theta:2d} x {n_x:2d}: at w_A = {W_CHECK}  P = {d[0]:.0f}, w_B = {d[1]:.4f}, "
-            f"u_C = {d[2]:.4f}; P = {curve[-1, 0]:.0f} at w_A = 3; {wall:.1f} s, "
-            f"{res.totals['newton_iterations']} iterations, {res.totals['cuts']} cuts")
-    studies[membrane] = np.array(rows)
-study = studies["opt"]
-for membrane, st in studies.items():
-    changes = np.abs(np.diff(st[:, 2])) / st[1:, 2]
-    say(f"{membrane.upper()}: P at w_A = {W_CHECK} changes by " + ", ".join(f"{100 * c:.1f} %" for c in changes)
-        + " from mesh to mesh")
-
-if comm.rank == 0:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    np.savetxt(os.path.join(out, "mesh_convergence.csv"),
+def three_meshes(demo):
+    """Per membrane, one row per mesh: (n_θ, n_x, P, w_B, u_C at w_A = 2.5, wall time, Newton
+    iterations, cuts, last P); the OPT curves."""
+    meshes = [(8, 12), (12, 18), (16, 24)] if demo.ci else [(8, 12), (16, 24), (24, 36)]
+    studies, curves = {}, {}
+    for membrane in ("opt", "cst"):
+        rows = []
+        for n_theta, n_x in meshes:
+            curve, res, wall = pullout(n_theta, n_x, membrane=membrane)
+            if membrane == "opt":
+                curves[(n_theta, n_x)] = curve
+            d = at_wA(curve, W_CHECK)
+            rows.append((n_theta, n_x, *d, wall, res.totals["newton_iterations"], res.totals["cuts"], curve[-1, 0]))
+            demo.say(f"{membrane.upper():3s} {n_theta:2d} x {n_x:2d}: at w_A = {W_CHECK}  P = {d[0]:.0f}, "
+                     f"w_B = {d[1]:.4f}, u_C = {d[2]:.4f}; P = {curve[-1, 0]:.0f} at w_A = 3; {wall:.1f} s, "
+                     f"{res.totals['newton_iterations']} iterations, {res.totals['cuts']} cuts")
+        studies[membrane] = np.array(rows)
+    for membrane, st in studies.items():
+        changes = np.abs(np.diff(st[:, 2])) / st[1:, 2]
+        demo.say(f"{membrane.upper()}: P at w_A = {W_CHECK} changes by "
+                 + ", ".join(f"{100 * c:.1f} %" for c in changes) + " from mesh to mesh")
+    demo.table("mesh_convergence.csv",
                np.c_[np.r_[np.ones(len(meshes)), np.zeros(len(meshes))], np.vstack([studies["opt"], studies["cst"]])],
-               delimiter=",", header="opt_membrane,n_theta,n_x,P_at_wA_2.5,wB_at_wA_2.5,uC_at_wA_2.5,wall_s,"
-               "iterations,cuts,P_last", comments="")
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+               ["opt_membrane", "n_theta", "n_x", "P_at_wA_2.5", "wB_at_wA_2.5", "uC_at_wA_2.5", "wall_s",
+                "iterations", "cuts", "P_last"])
+    return studies, curves
+
+
+def plot(demo, curves):
+    fig, ax = demo.figure(figsize=(6.5, 4.5))
     for (nt, nx), c in curves.items():
         m = c[:, 0] <= 1.1 * P_end
         for k, (name, style) in enumerate((("$w_A$", "-"), ("$w_B$", "--"), ("$-u_C$", ":")), start=1):
             sign = -1.0 if k == 3 else 1.0
             ax.plot(sign * c[m, k], c[m, 0], style, label=f"{name}, {nt}x{nx}")
-    ax.set_xlabel("radial displacement")
-    ax.set_ylabel("P")
-    ax.set_title("Pull-out of an open-ended cylinder (1/8 model)")
+    ax.set(xlabel="radial displacement", ylabel="P", title="Pull-out of an open-ended cylinder (1/8 model)")
     ax.legend(fontsize=7, ncol=3)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "cylinder_pullout.png"), dpi=120)
-    plt.close(fig)
-    finest = curves[meshes[-1]]
-    with open(os.path.join(out, "tip_values.json"), "w") as f:
-        json.dump({"load_factor": (finest[:, 1] / 3.0).tolist(), "P_over_40000": (finest[:, 0] / P_end).tolist(),
-                   "wA": finest[:, 1].tolist(), "wB": finest[:, 2].tolist(), "uC": finest[:, 3].tolist(),
-                   "ranks": comm.size}, f)
+    demo.save(fig, "cylinder_pullout.png")
+    finest = list(curves.values())[-1]
+    demo.record(load_factor=finest[:, 1] / 3.0, P_over_40000=finest[:, 0] / P_end, wA=finest[:, 1],
+                wB=finest[:, 2], uC=finest[:, 3])
+
 
 # %% [markdown]
 # ## Verification
 
 # %%
-for st in studies.values():
-    assert np.all(st[:, 8] >= P_end) and np.all(st[:, 7] == 0)  # P = 40 000 reached, no failed step
-    d_coarse = np.abs(st[1, 2:5] - st[0, 2:5])
-    d_fine = np.abs(st[2, 2:5] - st[1, 2:5])
-    assert np.all(d_fine < d_coarse), (d_coarse, d_fine)  # the curve converges with the mesh
-opt, cst = studies["opt"], studies["cst"]
-assert abs(opt[2, 2] - opt[1, 2]) / opt[2, 2] < 0.02    # OPT: the force at w_A = 2.5 within 2 % on the last refinement
-assert np.all(np.diff(opt[:, 2]) > 0) and np.all(np.diff(cst[:, 2]) < 0)  # from below and from above
-assert abs(opt[2, 2] - opt[1, 2]) < 0.5 * abs(cst[2, 2] - cst[1, 2])    # OPT converges faster
-assert abs(opt[2, 2] - cst[2, 2]) / opt[2, 2] < 0.1     # to the same force
-say("cylinder_pullout: verified")
+def main() -> dict:
+    demo = Demo("cylinder_pullout")
+    studies, curves = three_meshes(demo)
+    plot(demo, curves)
+    for membrane, st in studies.items():
+        demo.check(f"{membrane.upper()}: force at w_A = 3, every mesh (P = 40 000 reached)", st[:, 8],
+                   bound=(P_end, None), reference="the seed's load range (P up to 40 000)")
+        demo.check(f"{membrane.upper()}: failed load steps, every mesh", st[:, 7], 0,
+                   reference="solver acceptance (no published value)")
+        d_coarse = np.abs(st[1, 2:5] - st[0, 2:5])
+        d_fine = np.abs(st[2, 2:5] - st[1, 2:5])
+        demo.check(f"{membrane.upper()}: change of (P, w_B, u_C) at w_A = 2.5 on the last refinement minus the "
+                   "first (the curve converges with the mesh)", d_fine - d_coarse, bound=(None, 0.0),
+                   reference=SELF)
+    opt, cst = studies["opt"], studies["cst"]
+    demo.check("OPT: relative change of P at w_A = 2.5 on the last refinement", abs(opt[2, 2] - opt[1, 2]) / opt[2, 2],
+               bound=0.02, reference=SELF)
+    demo.check("OPT: increase of P at w_A = 2.5 from mesh to mesh (from below)", np.diff(opt[:, 2]),
+               bound=(0.0, None), reference=SELF)
+    demo.check("CST: change of P at w_A = 2.5 from mesh to mesh (from above)", np.diff(cst[:, 2]),
+               bound=(None, 0.0), reference=SELF)
+    demo.check("last change of P, OPT / CST (OPT converges faster)",
+               abs(opt[2, 2] - opt[1, 2]) / abs(cst[2, 2] - cst[1, 2]), bound=0.5, reference=SELF)
+    demo.check("OPT against CST on the finest mesh: P at w_A = 2.5 (to the same force)", cst[2, 2], opt[2, 2],
+               rtol=0.1, reference=SELF)
+    return demo.finish()
+
+
+if __name__ == "__main__":
+    logging.basicConfig(level=logging.WARNING)
+    main()

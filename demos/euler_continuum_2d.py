@@ -45,33 +45,23 @@
 # do not do yet.
 
 # %%
-import json
 import logging
-import os
-import time
 
 import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
 from dolfinx_corot.closed_forms import cantilever_elastica_force_ratio
-from dolfinx_corot.io import output_dir, reference
+from dolfinx_corot.gallery import Demo, timed
+from dolfinx_corot.io import reference
 
 comm = MPI.COMM_WORLD
-logging.basicConfig(level=logging.WARNING)
-out = output_dir("euler_continuum_2d")
+B4 = "B4 St Venant–Kirchhoff bifurcation load 203.77 kN/m (reference/B4_continuum_euler_buckling.json)"
 ref = reference("B4_continuum_euler_buckling")
 p = ref["problem"]
 L, H, E = p["L"], p["H"], p["E"]
 P_ref = ref["continuum_numerical"]["plane_strain_extrapolated"]["P_exact_bifurcation"]
 elastica = np.array(ref["postbuckling_elastica"]["data"])  # F/Fcr, w/L, shortening/L, rotation
-CI = os.environ.get("CI") == "true"
-
-
-def say(*args):
-    if comm.rank == 0:
-        print(*args, flush=True)
-
 
 # %% [markdown]
 # ## The column as a structured gmsh rectangle of quadrilaterals
@@ -106,26 +96,21 @@ SHORTENING = 1.0
 LOAD_FACTORS = list(np.r_[np.linspace(0.0, 0.04, 81)[1:], np.linspace(0.04, SHORTENING, 25)[1:]] / SHORTENING)
 
 
-def run(nx: int, ny: int, degree: int):
-    tm = column(nx, ny)
+def compress(tm, degree: int, clamp: str):
+    """The column of mesh ``tm`` (cell group "weak", point group "tip"), clamped on ``clamp`` and
+    pushed at "tip": (scene, result, wall time)."""
     scene = dc.Scene(large_rotations=True, linear_solver="direct")
     col = scene.add_solid(tm, material=dc.SaintVenantKirchhoff(E, 0.0), degree=degree)
     scene.add_solid(tm, "weak", material=dc.SaintVenantKirchhoff(0.5 * E, 0.0), degree=degree)
-    scene.fix(col, "clamp")
+    scene.fix(col, clamp)
     scene.prescribe(col, "tip", ux=-SHORTENING)
     scene.monitor("tip", col, "tip")
     scene.monitor_reaction("tip", col, "tip")
-    t0 = time.perf_counter()
-    res = dc.solve(scene, dc.LoadControl(load_factors=LOAD_FACTORS))
-    wall = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    res, wall = timed(dc.solve, scene, dc.LoadControl(load_factors=LOAD_FACTORS))
     return scene, res, wall
 
 
 elastica_ratio = cantilever_elastica_force_ratio
-
-
-# the closed form against the tabulated elastica of the reference
-assert all(abs(elastica_ratio(w) - r) < 2e-3 for r, w in elastica[1:6, :2])
 
 
 def critical_load(res):
@@ -142,41 +127,40 @@ def critical_load(res):
 # ## Meshes: linear and quadratic quadrilaterals
 
 # %%
-studies = [(10, 2, 2), (20, 2, 2), (40, 4, 2), (80, 8, 1), (160, 16, 1), (320, 32, 1)]
-if CI:
-    studies = [(10, 2, 2), (20, 2, 2), (40, 4, 2), (80, 8, 1), (160, 16, 1)]
-rows, curves = [], {}
-for nx, ny, degree in studies:
-    scene, res, wall = run(nx, ny, degree)
-    Pcr, npts = critical_load(res)
-    err = (Pcr - P_ref) / P_ref
-    h = res.history
-    F_path, w_path = -h.column("tip_Fx"), np.abs(h.column("tip_uy")) / L
-    overshoot = float(F_path[w_path < 0.05].max() / P_ref - 1.0)
-    rows.append({"nx": nx, "ny": ny, "degree": degree, "dofs": 2 * ((degree * nx + 1) * (degree * ny + 1)),
-                 "P_cr": Pcr, "error": err, "overshoot": overshoot, "wall_s": wall, "newton_iterations": res.totals["newton_iterations"],
-                 "cuts": res.totals["cuts"], "max_iterations": int(h.column("iterations").max())})
-    curves[(nx, ny, degree)] = (np.abs(h.column("tip_uy")), -h.column("tip_Fx"), -h.column("tip_ux"))
-    say(f"Q{degree} {nx:3d} x {ny:2d}: P_cr = {Pcr:8.3f} kN/m ({100 * err:+.2f} % against {P_ref:.2f}; "
-        f"{npts} points; overshoot {100 * overshoot:+.1f} %), {wall:5.1f} s, {res.totals['newton_iterations']} iterations, "
-        f"at most {rows[-1]['max_iterations']} per step, {res.totals['cuts']} cuts")
-say("effects:", scene.effects())
-residuals = [float(r) for r in res.history.rows[len(res.history) // 2]["residuals"].split()]
-say("Newton residuals of a mid-path step:", " ".join(f"{r:.1e}" for r in residuals),
-    "(observed orders", ", ".join(f"{np.log(c / b) / np.log(b / a):.2f}"
-                                  for a, b, c in zip(residuals, residuals[1:], residuals[2:])) + ")")
+def work_precision(demo):
+    """One row per mesh (critical load, its error, overshoot, time, iterations), the curves, and the
+    Newton residuals of a mid-path step on the last mesh."""
+    studies = [(10, 2, 2), (20, 2, 2), (40, 4, 2), (80, 8, 1), (160, 16, 1), (320, 32, 1)]
+    if demo.ci:
+        studies = [(10, 2, 2), (20, 2, 2), (40, 4, 2), (80, 8, 1), (160, 16, 1)]
+    rows, curves = [], {}
+    for nx, ny, degree in studies:
+        scene, res, wall = compress(column(nx, ny), degree, "clamp")
+        Pcr, npts = critical_load(res)
+        err = (Pcr - P_ref) / P_ref
+        h = res.history
+        F_path, w_path = -h.column("tip_Fx"), np.abs(h.column("tip_uy")) / L
+        overshoot = float(F_path[w_path < 0.05].max() / P_ref - 1.0)
+        rows.append({"nx": nx, "ny": ny, "degree": degree, "dofs": 2 * ((degree * nx + 1) * (degree * ny + 1)),
+                     "P_cr": Pcr, "error": err, "overshoot": overshoot, "wall_s": wall,
+                     "newton_iterations": res.totals["newton_iterations"],
+                     "cuts": res.totals["cuts"], "max_iterations": int(h.column("iterations").max())})
+        curves[(nx, ny, degree)] = (np.abs(h.column("tip_uy")), -h.column("tip_Fx"), -h.column("tip_ux"))
+        demo.say(f"Q{degree} {nx:3d} x {ny:2d}: P_cr = {Pcr:8.3f} kN/m ({100 * err:+.2f} % against {P_ref:.2f}; "
+                 f"{npts} points; overshoot {100 * overshoot:+.1f} %), {wall:5.1f} s, "
+                 f"{res.totals['newton_iterations']} iterations, "
+                 f"at most {rows[-1]['max_iterations']} per step, {res.totals['cuts']} cuts")
+    demo.say("effects:", scene.effects())
+    residuals = [float(r) for r in res.history.rows[len(res.history) // 2]["residuals"].split()]
+    demo.say("Newton residuals of a mid-path step:", " ".join(f"{r:.1e}" for r in residuals),
+             "(observed orders", ", ".join(f"{np.log(c / b) / np.log(b / a):.2f}"
+                                           for a, b, c in zip(residuals, residuals[1:], residuals[2:])) + ")")
+    demo.table("work_precision.csv", rows)
+    return rows, curves, residuals
 
-if comm.rank == 0:
-    import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    with open(os.path.join(out, "work_precision.csv"), "w") as f:
-        f.write(",".join(rows[0]) + "\n")
-        for r in rows:
-            f.write(",".join(str(v) for v in r.values()) + "\n")
-    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+def plot(demo, rows, curves):
+    fig, (ax, ax2) = demo.figure(1, 2, figsize=(11, 4.2))
     for key, (w, F, _) in curves.items():
         ax.plot(w / L, F, "-", lw=1, label=f"Q{key[2]} {key[0]}×{key[1]}")
     ws = np.linspace(0.0, 0.6, 61)
@@ -184,37 +168,54 @@ if comm.rank == 0:
     for name, val in (("Euler", ref["beam_theory"]["P_Euler"]), ("continuum bifurcation", P_ref)):
         ax.axhline(val, color="grey", lw=0.6, ls=":")
         ax.text(0.02, val + 0.5, f"{name} {val:.1f}", fontsize=7)
-    ax.set_xlabel("lateral tip deflection w / L")
-    ax.set_ylabel("F (kN/m)")
-    ax.set_ylim(0, 1.15 * P_ref)
+    ax.set(xlabel="lateral tip deflection w / L", ylabel="F (kN/m)", ylim=(0, 1.15 * P_ref),
+           title="Euler continuum, plane strain")
     ax.legend(fontsize=7)
-    ax.set_title("Euler continuum, plane strain")
     for degree, marker in ((1, "s-"), (2, "o-")):
         rr = [r for r in rows if r["degree"] == degree]
         ax2.loglog([r["wall_s"] for r in rr], [abs(r["error"]) for r in rr], marker, label=f"Q{degree}")
         for r in rr:
             ax2.annotate(f"{r['nx']}×{r['ny']}", (r["wall_s"], abs(r["error"])), fontsize=7)
-    ax2.set_xlabel("wall time (s)")
-    ax2.set_ylabel("|P_cr − 203.77| / 203.77")
+    ax2.set(xlabel="wall time (s)", ylabel="|P_cr − 203.77| / 203.77", title="What accuracy costs")
     ax2.legend(fontsize=8)
-    ax2.set_title("What accuracy costs")
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "euler_continuum_2d.png"), dpi=120)
-    plt.close(fig)
+    demo.save(fig, "euler_continuum_2d.png")
     w, F, _ = curves[(40, 4, 2)]
-    with open(os.path.join(out, "tip_values.json"), "w") as f:
-        json.dump({"load_factor": LOAD_FACTORS[: len(F)], "F": F.tolist(), "w": w.tolist(), "ranks": comm.size}, f)
+    demo.record(load_factor=LOAD_FACTORS[: len(F)], F=F, w=w)
+
 
 # %% [markdown]
 # ## Verification
 
 # %%
-q2 = [r for r in rows if r["degree"] == 2]
-q1 = [r for r in rows if r["degree"] == 1]
-assert all(abs(r["error"]) < 0.005 for r in q2), q2  # quadratic elements within 0.5 % of 203.77 on every mesh
-assert abs(q2[-1]["P_cr"] - q2[-2]["P_cr"]) < abs(q2[-2]["P_cr"] - q2[0]["P_cr"])  # and converging
-assert q1[-1]["overshoot"] < 0.01 and abs(q1[-1]["error"]) < 0.005, q1[-1]  # Q4 on 160 × 16 bends and agrees
-assert all(r["cuts"] == 0 and r["overshoot"] < 0.01 for r in q2)  # Q2 bends at the bifurcation
-orders = [np.log(c / b) / np.log(b / a) for a, b, c in zip(residuals, residuals[1:], residuals[2:])]
-assert max(orders) > 1.6, (residuals, orders)  # Newton's asymptotic rate is quadratic
-say("euler_continuum_2d: verified")
+def main() -> dict:
+    demo = Demo("euler_continuum_2d")
+    # the closed form against the tabulated elastica of the reference
+    demo.check("closed-form elastica F/F_cr at the first tabulated deflections",
+               [elastica_ratio(w) for r, w in elastica[1:6, :2]], elastica[1:6, 0], atol=2e-3,
+               reference="B4 tabulated post-buckling elastica (reference/B4_continuum_euler_buckling.json)")
+    rows, curves, residuals = work_precision(demo)
+    plot(demo, rows, curves)
+    q2 = [r for r in rows if r["degree"] == 2]
+    q1 = [r for r in rows if r["degree"] == 1]
+    demo.check("Q9: relative error of the critical load, every mesh (within 0.5 %)", [r["error"] for r in q2],
+               bound=(-0.005, 0.005), reference=B4)
+    demo.check("Q9: change of P_cr on the last refinement / change from the coarsest (converging)",
+               abs(q2[-1]["P_cr"] - q2[-2]["P_cr"]) / abs(q2[-2]["P_cr"] - q2[0]["P_cr"]), bound=1.0,
+               reference="self-convergence (no published value)")
+    demo.check(f"Q4 {q1[-1]['nx']} x {q1[-1]['ny']}: overshoot of the straight path (it bends)",
+               q1[-1]["overshoot"], bound=0.01, reference=B4)
+    demo.check(f"Q4 {q1[-1]['nx']} x {q1[-1]['ny']}: relative error of the critical load", q1[-1]["error"],
+               bound=(-0.005, 0.005), reference=B4)
+    demo.check("Q9: failed load steps, every mesh", [r["cuts"] for r in q2], 0,
+               reference="solver acceptance (no published value)")
+    demo.check("Q9: overshoot of the straight path, every mesh (it bends at the bifurcation)",
+               [r["overshoot"] for r in q2], bound=0.01, reference=B4)
+    orders = [np.log(c / b) / np.log(b / a) for a, b, c in zip(residuals, residuals[1:], residuals[2:])]
+    demo.check("Newton: largest observed rate of convergence, a mid-path step", max(orders), bound=(1.6, None),
+               reference="Newton's method: quadratic convergence")
+    return demo.finish()
+
+
+if __name__ == "__main__":
+    logging.basicConfig(level=logging.WARNING)
+    main()

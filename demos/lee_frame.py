@@ -22,29 +22,19 @@
 # The load factor is $\lambda = PL^2/EI$.
 
 # %%
-import json
 import logging
-import os
-import time
 
 import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
-from dolfinx_corot.io import output_dir
+from dolfinx_corot.gallery import Demo, timed
 from dolfinx_corot.io.gmsh_models import polyline
 from dolfinx_corot.result import limit_load
 
 comm = MPI.COMM_WORLD
-logging.basicConfig(level=logging.WARNING)
-out = output_dir("lee_frame")
 L, E, A, I = 120.0, 720.0, 6.0, 2.0
 P_ref = 18.5  # published limit load PL²/EI
-
-
-def say(*args):
-    if comm.rank == 0:
-        print(*args, flush=True)
 
 
 def lee_frame(n):
@@ -60,64 +50,64 @@ def lee_frame(n):
     return scene
 
 
+driver = dc.ArcLength(initial_increment=0.5, desired_iterations=4, max_steps=400,
+                      stop=lambda row: row["P_uy"] < -100.0)
+
 # %% [markdown]
 # ## The path with 20 elements
 
 # %%
-scene = lee_frame(1)
-shapes = {}
+def path(demo):
+    """The arc-length run on 20 elements, its deformed shapes, and the limit loads (max, min)."""
+    scene = lee_frame(1)
+    shapes = {}
 
+    def snapshot(row):
+        X, state = scene.model.nodes()
+        order = np.argsort(X[:, 1] + X[:, 0])  # along the frame: up the column, then along the beam
+        shapes[row["step"]] = ((X + state[:, :2])[order], row["load_factor"])
 
-def snapshot(row):
-    X, state = scene.model.nodes()
-    order = np.argsort(X[:, 1] + X[:, 0])  # along the frame: up the column, then along the beam
-    shapes[row["step"]] = ((X + state[:, :2])[order], row["load_factor"])
+    result, wall = timed(dc.solve, scene, driver, on_step=snapshot)
+    hist = result.history
+    demo.write_result(result)
+    lam, u, v = hist.column("load_factor"), hist.column("P_ux"), hist.column("P_uy")
+    lam0, u0, v0 = np.r_[0.0, lam], np.r_[0.0, u], np.r_[0.0, v]
+    P_max = limit_load(lam0, u0, v0)  # the first maximum, refined by a parabola along the path
+    P_min = limit_load(lam0, u0, v0, kind="min", first=False)
+    iters = hist.column("iterations")
+    demo.say(f"{len(hist)} arc-length steps, {result.totals['newton_iterations']} iterations, "
+             f"{result.totals['cuts']} cuts, {wall:.2f} s; iterations per step {int(iters.min())}-{int(iters.max())}")
+    demo.say(f"limit loads: P_max L²/EI = {P_max:.4f} (published {P_ref}), P_min L²/EI = {P_min:.4f}")
+    demo.record(load_factor=lam, ux=u, uy=v, rz=hist.column("P_rz"))
+    return result, shapes, P_max, P_min
 
-
-driver = dc.ArcLength(initial_increment=0.5, desired_iterations=4, max_steps=400,
-                      stop=lambda row: row["P_uy"] < -100.0)
-t0 = time.perf_counter()
-result = dc.solve(scene, driver, on_step=snapshot)
-wall = time.perf_counter() - t0
-hist = result.history
-if comm.rank == 0:
-    result.write(out)
-lam, u, v = hist.column("load_factor"), hist.column("P_ux"), hist.column("P_uy")
-lam0, u0, v0 = np.r_[0.0, lam], np.r_[0.0, u], np.r_[0.0, v]
-P_max = limit_load(lam0, u0, v0)  # the first maximum, refined by a parabola along the path
-P_min = limit_load(lam0, u0, v0, kind="min", first=False)
-iters = hist.column("iterations")
-say(f"{len(hist)} arc-length steps, {result.totals['newton_iterations']} iterations, "
-    f"{result.totals['cuts']} cuts, {wall:.2f} s; iterations per step {int(iters.min())}-{int(iters.max())}")
-say(f"limit loads: P_max L²/EI = {P_max:.4f} (published {P_ref}), P_min L²/EI = {P_min:.4f}")
 
 # %% [markdown]
 # ## Mesh convergence of the limit load
 
 # %%
-study = []
-for n in ([1, 2] if os.environ.get("CI") == "true" else [1, 2, 4]):
-    sc = lee_frame(n)
-    t0 = time.perf_counter()
-    r = dc.solve(sc, driver)
-    dt = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
-    lm = np.r_[0.0, r.history.column("load_factor")]
-    uu, vv = np.r_[0.0, r.history.column("P_ux")], np.r_[0.0, r.history.column("P_uy")]
-    pm = limit_load(lm, uu, vv)
-    study.append((20 * n, pm, limit_load(lm, uu, vv, kind="min", first=False), dt, r.totals["cuts"]))
-    say(f"{20 * n:3d} elements: P_max L²/EI = {pm:.4f}, P_min L²/EI = {study[-1][2]:.4f}, "
-        f"{dt:.2f} s, {r.totals['cuts']} cuts")
-study = np.array(study)
+def mesh_convergence(demo):
+    """(elements, P_max L²/EI, P_min L²/EI, wall time, cuts) per mesh."""
+    study = []
+    for n in ([1, 2] if demo.ci else [1, 2, 4]):
+        sc = lee_frame(n)
+        r, dt = timed(dc.solve, sc, driver)
+        lm = np.r_[0.0, r.history.column("load_factor")]
+        uu, vv = np.r_[0.0, r.history.column("P_ux")], np.r_[0.0, r.history.column("P_uy")]
+        pm = limit_load(lm, uu, vv)
+        study.append((20 * n, pm, limit_load(lm, uu, vv, kind="min", first=False), dt, r.totals["cuts"]))
+        demo.say(f"{20 * n:3d} elements: P_max L²/EI = {pm:.4f}, P_min L²/EI = {study[-1][2]:.4f}, "
+                 f"{dt:.2f} s, {r.totals['cuts']} cuts")
+    study = np.array(study)
+    demo.table("mesh_convergence.csv", study,
+               ["elements", "P_max_L2_over_EI", "P_min_L2_over_EI", "wall_time_s", "cuts"])
+    return study
 
-if comm.rank == 0:
-    import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    np.savetxt(os.path.join(out, "mesh_convergence.csv"), study, delimiter=",",
-               header="elements,P_max_L2_over_EI,P_min_L2_over_EI,wall_time_s,cuts", comments="")
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.5))
+def plot(demo, hist, shapes):
+    lam0, u0, v0 = (np.r_[0.0, hist.column(c)] for c in ("load_factor", "P_ux", "P_uy"))
+    iters = hist.column("iterations")
+    fig, ax = demo.figure(1, 3, figsize=(15, 4.5))
     ax[0].plot(-v0, lam0, "o-", ms=2.5, label="$-v$ (down) at the load")
     ax[0].plot(u0, lam0, "s-", ms=2.5, label="$u$ at the load")
     ax[0].axhline(P_ref, color="0.5", ls="--", lw=0.8, label="published limit 18.5")
@@ -137,20 +127,37 @@ if comm.rank == 0:
     ax[2].plot(np.arange(1, len(iters) + 1), iters, "s-", ms=3)
     ax[2].set_xlabel("arc-length step")
     ax[2].set_ylabel("Newton iterations")
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "lee_frame.png"), dpi=120)
-    plt.close(fig)
-    with open(os.path.join(out, "tip_values.json"), "w") as f:
-        json.dump({"load_factor": lam.tolist(), "ux": u.tolist(), "uy": v.tolist(),
-                   "rz": hist.column("P_rz").tolist(), "ranks": comm.size}, f)
+    demo.save(fig, "lee_frame.png")
+
 
 # %% [markdown]
 # ## Verification
 
 # %%
-assert abs(P_max - P_ref) / P_ref < 0.01, P_max  # published limit load within 1 %
-assert result.totals["cuts"] == 0 and np.all(study[:, 4] == 0)  # no failed arc-length step
-assert iters.max() <= 6, iters.max()
-assert P_min < -9.0 and lam[-1] > 10.0  # passed the load minimum and came back up
-assert np.ptp(study[:, 1]) / P_ref < 2e-3  # limit load converged in the mesh
-say("lee_frame: verified")
+def main() -> dict:
+    demo = Demo("lee_frame")
+    result, shapes, P_max, P_min = path(demo)
+    study = mesh_convergence(demo)
+    hist = result.history
+    plot(demo, hist, shapes)
+    demo.check("limit load P_max L²/EI, 20 elements (within 1 %)", P_max, P_ref, rtol=0.01,
+               reference="published limit load PL²/EI ≈ 18.5 (Lee, Manuel & Rossow 1968; Schweizerhof & "
+                         "Wriggers 1986)")
+    demo.check("failed arc-length steps, every mesh", [result.totals["cuts"], *study[:, 4]], 0,
+               reference="solver acceptance (no published value)")
+    demo.check("Newton iterations per step", hist.column("iterations").max(), bound=6,
+               reference="solver acceptance (no published value)")
+    demo.check("load minimum P_min L²/EI (the path passes it)", P_min, bound=(None, -9.0),
+               reference="path shape as published: a load minimum below zero (Schweizerhof & Wriggers "
+                         "1986); the bound −9 is ours")
+    demo.check("last load factor (the path comes back up)", hist.column("load_factor")[-1], bound=(10.0, None),
+               reference="path shape as published: stiffening after the load minimum (Schweizerhof & "
+                         "Wriggers 1986); the bound 10 is ours")
+    demo.check("spread of P_max L²/EI over the meshes / 18.5 (limit load converged in the mesh)",
+               np.ptp(study[:, 1]) / P_ref, bound=2e-3, reference="self-convergence (no published value)")
+    return demo.finish()
+
+
+if __name__ == "__main__":
+    logging.basicConfig(level=logging.WARNING)
+    main()

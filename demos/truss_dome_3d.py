@@ -26,26 +26,17 @@
 # only; nodal rotations have no stiffness and are fixed automatically).
 
 # %%
-import json
 import logging
-import os
-import time
 
 import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
-from dolfinx_corot.io import output_dir
+from dolfinx_corot.gallery import Demo, timed
 
 comm = MPI.COMM_WORLD
-logging.basicConfig(level=logging.WARNING)
-out = output_dir("truss_dome_3d")
+EXACT = "closed-form equilibrium path P(w) of the symmetric dome (in this demo)"
 R, h, EA, nbars = 50.0, 5.0, 1e6, 6
-
-
-def say(*args):
-    if comm.rank == 0:
-        print(*args, flush=True)
 
 
 def P_exact(w):
@@ -57,7 +48,6 @@ def P_exact(w):
 w_fine = np.linspace(0.0, 2.2 * h, 22001)
 P_max = P_exact(w_fine[w_fine <= h]).max()  # the snap-through load
 P_min = P_exact(w_fine[w_fine >= h]).min()  # and the load of the inverted dome's snap back
-say(f"exact limit loads: P_max = {P_max:.3f}, P_min = {P_min:.3f}")
 
 # %% [markdown]
 # ## The dome as a gmsh model: six bars, named apex and supports
@@ -65,65 +55,61 @@ say(f"exact limit loads: P_max = {P_max:.3f}, P_min = {P_min:.3f}")
 # %%
 import gmsh  # noqa: E402
 
-if comm.rank == 0:
-    gmsh.initialize()
-    gmsh.option.setNumber("General.Terminal", 0)
-    apex = gmsh.model.geo.addPoint(0.0, 0.0, h)
-    feet = [gmsh.model.geo.addPoint(R * np.cos(t), R * np.sin(t), 0.0)
-            for t in np.arange(nbars) * 2 * np.pi / nbars]
-    bars = [gmsh.model.geo.addLine(apex, f) for f in feet]
-    gmsh.model.geo.synchronize()
-    for bar in bars:
-        gmsh.model.mesh.setTransfiniteCurve(bar, 2)  # one bar element per member
-    gmsh.model.addPhysicalGroup(1, bars, 1)
-    gmsh.model.setPhysicalName(1, 1, "bars")
-    gmsh.model.addPhysicalGroup(0, [apex], 2)
-    gmsh.model.setPhysicalName(0, 2, "apex")
-    gmsh.model.addPhysicalGroup(0, feet, 3)
-    gmsh.model.setPhysicalName(0, 3, "supports")
-    gmsh.model.mesh.generate(1)
-tmesh = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=3, comm=comm)
-if comm.rank == 0:
-    gmsh.finalize()
 
-scene = dc.Scene(large_rotations=True)
-truss = scene.add_truss(tmesh, "bars", area=1.0, material=dc.Elastic(EA))
-scene.fix(truss, "supports", dofs=("ux", "uy", "uz"))
-scene.load(truss, "apex", force=(0.0, 0.0, -1.0))  # λ = P
-scene.monitor("apex", truss, "apex")
-say("effects:", scene.effects())
+def dome(demo):
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        apex = gmsh.model.geo.addPoint(0.0, 0.0, h)
+        feet = [gmsh.model.geo.addPoint(R * np.cos(t), R * np.sin(t), 0.0)
+                for t in np.arange(nbars) * 2 * np.pi / nbars]
+        bars = [gmsh.model.geo.addLine(apex, f) for f in feet]
+        gmsh.model.geo.synchronize()
+        for bar in bars:
+            gmsh.model.mesh.setTransfiniteCurve(bar, 2)  # one bar element per member
+        gmsh.model.addPhysicalGroup(1, bars, 1)
+        gmsh.model.setPhysicalName(1, 1, "bars")
+        gmsh.model.addPhysicalGroup(0, [apex], 2)
+        gmsh.model.setPhysicalName(0, 2, "apex")
+        gmsh.model.addPhysicalGroup(0, feet, 3)
+        gmsh.model.setPhysicalName(0, 3, "supports")
+        gmsh.model.mesh.generate(1)
+    tmesh = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=3, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+
+    scene = dc.Scene(large_rotations=True)
+    truss = scene.add_truss(tmesh, "bars", area=1.0, material=dc.Elastic(EA))
+    scene.fix(truss, "supports", dofs=("ux", "uy", "uz"))
+    scene.load(truss, "apex", force=(0.0, 0.0, -1.0))  # λ = P
+    scene.monitor("apex", truss, "apex")
+    demo.say("effects:", scene.effects())
+    return scene
+
 
 # %% [markdown]
 # ## Arc-length through the snap
 
 # %%
-t0 = time.perf_counter()
-result = dc.solve(scene, dc.ArcLength(initial_increment=100.0, max_growth=1.0, max_steps=400,
-                                      stop=lambda row: -row["apex_uz"] > 2.1 * h))
-wall = time.perf_counter() - t0
-hist = result.history
-if comm.rank == 0:
-    result.write(out)
-P = hist.column("load_factor")
-w = -hist.column("apex_uz")
-err = np.abs(P - P_exact(w)) / P_max
-lateral = np.abs(np.c_[hist.column("apex_ux"), hist.column("apex_uy")]).max()
-say(f"{len(hist)} steps, {result.totals['newton_iterations']} iterations, {result.totals['cuts']} cuts, "
-    f"{wall:.2f} s; iterations per step {int(hist.column('iterations').min())}-"
-    f"{int(hist.column('iterations').max())}")
-say(f"largest deviation from the exact path: {err.max():.1e} P_max; lateral apex motion {lateral:.1e}")
-P_top = P[w <= h].max()
-P_bottom = P[w >= h].min()
-say(f"computed limit loads (largest sampled points): {P_top:.3f} and {P_bottom:.3f} "
-    f"(exact {P_max:.3f}, {P_min:.3f})")
+def snap_through(demo, scene):
+    """The arc-length run: (result, P, w, deviation from the exact path / P_max, lateral motion)."""
+    driver = dc.ArcLength(initial_increment=100.0, max_growth=1.0, max_steps=400,
+                          stop=lambda row: -row["apex_uz"] > 2.1 * h)
+    result, wall = timed(dc.solve, scene, driver)
+    hist = result.history
+    demo.write_result(result)
+    P = hist.column("load_factor")
+    w = -hist.column("apex_uz")
+    err = np.abs(P - P_exact(w)) / P_max
+    lateral = np.abs(np.c_[hist.column("apex_ux"), hist.column("apex_uy")]).max()
+    demo.say(f"{len(hist)} steps, {result.totals['newton_iterations']} iterations, {result.totals['cuts']} cuts, "
+             f"{wall:.2f} s; iterations per step {int(hist.column('iterations').min())}-"
+             f"{int(hist.column('iterations').max())}")
+    demo.say(f"largest deviation from the exact path: {err.max():.1e} P_max; lateral apex motion {lateral:.1e}")
+    demo.say(f"computed limit loads (largest sampled points): {P[w <= h].max():.3f} and {P[w >= h].min():.3f} "
+             f"(exact {P_max:.3f}, {P_min:.3f})")
 
-if comm.rank == 0:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 4.2))
+    fig, ax = demo.figure(figsize=(6, 4.2))
     ax.plot(w_fine, P_exact(w_fine), "k-", lw=0.8, label="exact")
     ax.plot(w, P, "o", ms=3, label="arc-length, 3D co-rotational bars")
     ax.axhline(0.0, color="0.7", lw=0.6)
@@ -131,18 +117,34 @@ if comm.rank == 0:
     ax.set_ylabel("apex load P")
     ax.set_title("Shallow space-truss dome: snap-through")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "truss_dome_3d.png"), dpi=120)
-    plt.close(fig)
-    with open(os.path.join(out, "tip_values.json"), "w") as f:
-        json.dump({"load_factor": P.tolist(), "w": w.tolist(), "ranks": comm.size}, f)
+    demo.save(fig, "truss_dome_3d.png")
+    demo.record(load_factor=P, w=w)
+    return result, P, w, err, lateral
+
 
 # %% [markdown]
 # ## Verification
 
 # %%
-assert err.max() < 1e-8, err.max()  # every point on the exact path
-assert lateral < 1e-10
-assert result.totals["cuts"] == 0 and hist.column("iterations").max() <= 6
-assert P_top > 0.999 * P_max and P_bottom < 0.999 * P_min and w[-1] > 2 * h  # through both limit points
-say("truss_dome_3d: verified")
+def main() -> dict:
+    demo = Demo("truss_dome_3d")
+    demo.say(f"exact limit loads: P_max = {P_max:.3f}, P_min = {P_min:.3f}")
+    result, P, w, err, lateral = snap_through(demo, dome(demo))
+    demo.check("deviation of every path point from the exact path / P_max", err.max(), bound=1e-8,
+               reference=EXACT)
+    demo.check("lateral apex motion", lateral, bound=1e-10, reference="symmetry of the dome: none")
+    demo.check("failed arc-length steps", result.totals["cuts"], 0, reference="solver acceptance (no published value)")
+    demo.check("Newton iterations per step", result.history.column("iterations").max(), bound=6,
+               reference="solver acceptance (no published value)")
+    demo.check("largest sampled load before w = h / P_max (through the snap-through point)",
+               P[w <= h].max() / P_max, bound=(0.999, None), reference=EXACT)
+    demo.check("smallest sampled load after w = h / P_min (through the snap-back point)",
+               P[w >= h].min() / P_min, bound=(0.999, None), reference=EXACT)
+    demo.check("last apex deflection / h", w[-1] / h, bound=(2.0, None),
+               reference="the run's stop criterion (deflection 2.1 h)")
+    return demo.finish()
+
+
+if __name__ == "__main__":
+    logging.basicConfig(level=logging.WARNING)
+    main()

@@ -50,7 +50,6 @@
 # of the wheels at λ ≈ 1.4.
 
 # %%
-import json
 import logging
 import os
 
@@ -59,22 +58,12 @@ import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
-from dolfinx_corot.io import output_dir
+from dolfinx_corot.gallery import Demo
 
 comm = MPI.COMM_WORLD
-logging.basicConfig(level=logging.WARNING)
-if os.environ.get("DC_LOG"):
-    logging.getLogger("dolfinx_corot.solvers.drivers").setLevel(logging.INFO)
-out = output_dir("two_wheels")
-CI = os.environ.get("CI") == "true"
 R, R_HUB, GAP, E, NU = 1.0, 0.3, 0.02, 10.0, 0.3
 PUSH, LIFT = 0.3, 0.15
-STEPS = 32 if CI else 48
-
-
-def say(*args):
-    if comm.rank == 0:
-        print(*args, flush=True)
+STAGES = ("first contact", "advanced contact", "separation from each other", "lifted off the foundation")
 
 
 # %% [markdown]
@@ -120,26 +109,32 @@ def model(h: float):
 # ## Scene: three bodies, six interfaces, displacement-driven hubs
 
 # %%
-h = 0.06
-tm = model(h)
-sc = dc.Scene()
-body = sc.add_solid(tm, material=dc.NeoHookean(E, NU), degree=1)
-sc.fix(body, "base")
 path = dc.Amplitude(((0.0, 0.0), (1.0, -PUSH), (1.6, LIFT)))
-for side in ("left", "right"):
-    sc.prescribe(body, f"hub_{side}", ux=0.0)
-    sc.prescribe(body, f"hub_{side}", amplitude=path, uy=1.0)
-    sc.monitor_reaction(f"hub_{side}", body, f"hub_{side}")
-sc.monitor_reaction("base", body, "base")
-law = dc.AugmentedLagrangian()
-interfaces = {
-    "left-foundation": sc.contact(slaves=(body, "rim_left"), masters=(body, "foundation_top"), law=law, symmetric=True),
-    "right-foundation": sc.contact(slaves=(body, "rim_right"), masters=(body, "foundation_top"), law=law,
-                                   symmetric=True),
-    "wheel-wheel": sc.contact(slaves=(body, "rim_left"), masters=(body, "rim_right"), law=law, symmetric=True),
-}
-for line in sc.effects():
-    say(" ", line)
+
+
+def wheels_scene(demo, h=0.06):
+    """The scene and its three symmetric interfaces (wheel–foundation twice, wheel–wheel)."""
+    tm = model(h)
+    sc = dc.Scene()
+    body = sc.add_solid(tm, material=dc.NeoHookean(E, NU), degree=1)
+    sc.fix(body, "base")
+    for side in ("left", "right"):
+        sc.prescribe(body, f"hub_{side}", ux=0.0)
+        sc.prescribe(body, f"hub_{side}", amplitude=path, uy=1.0)
+        sc.monitor_reaction(f"hub_{side}", body, f"hub_{side}")
+    sc.monitor_reaction("base", body, "base")
+    law = dc.AugmentedLagrangian()
+    interfaces = {
+        "left-foundation": sc.contact(slaves=(body, "rim_left"), masters=(body, "foundation_top"), law=law,
+                                      symmetric=True),
+        "right-foundation": sc.contact(slaves=(body, "rim_right"), masters=(body, "foundation_top"), law=law,
+                                       symmetric=True),
+        "wheel-wheel": sc.contact(slaves=(body, "rim_left"), masters=(body, "rim_right"), law=law, symmetric=True),
+    }
+    for line in sc.effects():
+        demo.say(" ", line)
+    return sc, interfaces
+
 
 # %% [markdown]
 # ## Load path: 32 steps (λ = 0.05) down and back up
@@ -148,12 +143,6 @@ for line in sc.effects():
 # four stages for the snapshots.
 
 # %%
-stages = {"first contact": None, "advanced contact": 1.0, "separation from each other": None,
-          "lifted off the foundation": 1.6}
-records = []
-snapshots = {}
-
-
 def contact_force(pair):
     total = 0.0
     for itf in pair:
@@ -162,7 +151,7 @@ def contact_force(pair):
     return total
 
 
-def rims():
+def rims(interfaces):
     shapes = {}
     for name, pair in interfaces.items():
         for itf in pair:
@@ -171,50 +160,48 @@ def rims():
     return shapes
 
 
-def on_step(row):
-    lam = row["load_factor"]
-    rec = {"load_factor": lam, "hub_uy": path(lam), **{k: contact_force(v) for k, v in interfaces.items()},
-           "hub_Fy": row["hub_left_Fy"] + row["hub_right_Fy"], "base_Fy": row["base_Fy"],
-           "uzawa_updates": row["uzawa_updates"], "iterations": row["iterations"]}
-    records.append(rec)
-    touching = rec["wheel-wheel"] > 0
-    if touching and snapshots.get("first contact") is None:
-        snapshots["first contact"] = (lam, rims())
-    if abs(lam - 1.0) < 1e-9:
-        snapshots["advanced contact"] = (lam, rims())
-    if not touching and lam > 1.0 and snapshots.get("first contact") and not snapshots.get("separation from each other"):
-        snapshots["separation from each other"] = (lam, rims())
-    if abs(lam - 1.6) < 1e-9:
-        snapshots["lifted off the foundation"] = (lam, rims())
+def drive(demo, sc, interfaces):
+    """The run: its history, one record per step (contact forces, hub and base forces), and the
+    snapshots (load factor, rims) of the four stages."""
+    records = []
+    snapshots = {}
 
+    def on_step(row):
+        lam = row["load_factor"]
+        rec = {"load_factor": lam, "hub_uy": path(lam), **{k: contact_force(v) for k, v in interfaces.items()},
+               "hub_Fy": row["hub_left_Fy"] + row["hub_right_Fy"], "base_Fy": row["base_Fy"],
+               "uzawa_updates": row["uzawa_updates"], "iterations": row["iterations"]}
+        records.append(rec)
+        touching = rec["wheel-wheel"] > 0
+        if touching and snapshots.get("first contact") is None:
+            snapshots["first contact"] = (lam, rims(interfaces))
+        if abs(lam - 1.0) < 1e-9:
+            snapshots["advanced contact"] = (lam, rims(interfaces))
+        if (not touching and lam > 1.0 and snapshots.get("first contact")
+                and not snapshots.get("separation from each other")):
+            snapshots["separation from each other"] = (lam, rims(interfaces))
+        if abs(lam - 1.6) < 1e-9:
+            snapshots["lifted off the foundation"] = (lam, rims(interfaces))
 
-res = dc.solve(sc, dc.LoadControl(steps=STEPS, final=1.6), on_step=on_step)
-hist = res.history
-say(f"{len(hist)} steps, {int(hist.column('iterations').sum())} Newton iterations, "
-    f"{int(hist.column('cuts').sum())} cuts, at most {int(hist.column('uzawa_updates').max())} Uzawa updates per step")
-for name, snap in snapshots.items():
-    if snap:
-        say(f"  {name}: λ = {snap[0]:.2f}, hubs at u_y = {path(snap[0]):+.3f}")
+    res = dc.solve(sc, dc.LoadControl(steps=32 if demo.ci else 48, final=1.6), on_step=on_step)
+    hist = res.history
+    demo.say(f"{len(hist)} steps, {int(hist.column('iterations').sum())} Newton iterations, "
+             f"{int(hist.column('cuts').sum())} cuts, at most {int(hist.column('uzawa_updates').max())} "
+             "Uzawa updates per step")
+    for name, snap in snapshots.items():
+        if snap:
+            demo.say(f"  {name}: λ = {snap[0]:.2f}, hubs at u_y = {path(snap[0]):+.3f}")
+    return hist, records, snapshots
+
 
 # %% [markdown]
 # ## Output
 
 # %%
-X, u = sc.model.nodes()
-if comm.rank == 0:
-    import csv
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    with open(os.path.join(out, "history.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(records[0]))
-        w.writeheader()
-        w.writerows(records)
-    fig, axes = plt.subplots(2, 3, figsize=(14, 7))
-    for ax, (name, snap) in zip(axes.flat, [(k, snapshots.get(k)) for k in stages]):
+def plot(demo, records, snapshots):
+    demo.table("history.csv", records)
+    fig, axes = demo.figure(2, 3, figsize=(14, 7))
+    for ax, (name, snap) in zip(axes.flat, [(k, snapshots.get(k)) for k in STAGES]):
         if not snap:
             continue
         lam, shapes = snap
@@ -225,44 +212,62 @@ if comm.rank == 0:
             if key.startswith("rim"):
                 xx = np.vstack([xx, xx[:1]])
             ax.plot(xx[:, 0], xx[:, 1], "-", lw=1)
-        ax.set_aspect("equal")
-        ax.set_xlim(-2.6, 2.6)
-        ax.set_ylim(-0.6, 2.3)
+        ax.set(aspect="equal", xlim=(-2.6, 2.6), ylim=(-0.6, 2.3))
         ax.set_title(f"{name} (λ = {lam:.2f}, hubs {path(lam):+.2f})", fontsize=9)
     lam = [r["load_factor"] for r in records]
     ax = axes[1, 1]
     ax.plot(lam, [r["hub_uy"] for r in records], "k-")
-    ax.set_xlabel("λ")
-    ax.set_ylabel("vertical displacement of the hubs")
+    ax.set(xlabel="λ", ylabel="vertical displacement of the hubs")
     ax = axes[1, 2]
     for key in ("left-foundation", "right-foundation"):
         ax.plot(lam, [r[key] for r in records], "o-", ms=3, label=key)
-    ax.set_xlabel("λ")
-    ax.set_ylabel("wheel–foundation contact force (two passes)")
+    ax.set(xlabel="λ", ylabel="wheel–foundation contact force (two passes)")
     ax.legend(fontsize=7, loc="upper left")
     ax2 = ax.twinx()
     ax2.plot(lam, [r["wheel-wheel"] for r in records], "s-", ms=3, color="C2")
     ax2.set_ylabel("wheel–wheel contact force", color="C2")
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "two_wheels.png"), dpi=110)
-    plt.close(fig)
-    with open(os.path.join(out, "tip_values.json"), "w") as f:
-        json.dump({"ranks": comm.size, "load_factor": lam, "hub_Fy": [r["hub_Fy"] for r in records],
-                   "wheel_wheel": [r["wheel-wheel"] for r in records]}, f)
+    demo.save(fig, "two_wheels.png", dpi=110)
+    demo.record(load_factor=lam, hub_Fy=[r["hub_Fy"] for r in records],
+                wheel_wheel=[r["wheel-wheel"] for r in records])
+
 
 # %% [markdown]
 # ## Verification
 
 # %%
-assert hist.column("cuts").sum() == 0                          # no failed step
-assert hist.column("uzawa_updates").max() <= 5                   # AL within 5 updates per step
-for r in records:                                                # equilibrium of the whole model
-    assert abs(r["hub_Fy"] + r["base_Fy"]) < 1e-6 * max(1.0, abs(r["base_Fy"])), r
-first = snapshots.get("first contact")
-sep = snapshots.get("separation from each other")
-assert first is not None and first[0] < 1.0 and sep is not None and sep[0] > 1.0, (first, sep)
-lifted = [r for r in records if r["hub_uy"] > 0.02]
-assert lifted and all(r["left-foundation"] == 0.0 and r["right-foundation"] == 0.0 for r in lifted)
-left, right = hist.column("hub_left_Fy"), hist.column("hub_right_Fy")
-assert np.abs(left - right).max() < 0.02 * np.abs(left).max()  # (unstructured meshes: not mirror images)
-say("two_wheels: verified")
+def main() -> dict:
+    demo = Demo("two_wheels")
+    sc, interfaces = wheels_scene(demo)
+    hist, records, snapshots = drive(demo, sc, interfaces)
+    plot(demo, records, snapshots)
+    solver = "solver acceptance (no published value)"
+    demo.check("failed load steps", hist.column("cuts").sum(), 0, reference=solver)
+    demo.check("most Uzawa updates in a step (augmented Lagrangian)", hist.column("uzawa_updates").max(), bound=5,
+               reference=solver)
+    demo.check("hub forces + base reaction, every step / max(1, |base reaction|) (equilibrium of the model)",
+               [(r["hub_Fy"] + r["base_Fy"]) / max(1.0, abs(r["base_Fy"])) for r in records], bound=(-1e-6, 1e-6),
+               reference="global equilibrium: the hubs' forces balance the base reaction")
+    first = snapshots.get("first contact")
+    sep = snapshots.get("separation from each other")
+    stages = "the stages of seed §3.2.2 in order (our data; no published value)"
+    demo.check("load factor of the first wheel–wheel contact (before the lowest point)",
+               first[0] if first else np.nan, bound=(None, 1.0), reference=stages)
+    demo.check("load factor of the wheels' separation (during unloading)", sep[0] if sep else np.nan,
+               bound=(1.0, None), reference=stages)
+    lifted = [r for r in records if r["hub_uy"] > 0.02]
+    demo.check("steps with the hubs above +0.02 (the wheels lift off)", len(lifted), bound=(1, None),
+               reference=stages)
+    demo.check("wheel–foundation contact forces once lifted (none)",
+               [[r["left-foundation"], r["right-foundation"]] for r in lifted], 0.0, reference=stages)
+    left, right = hist.column("hub_left_Fy"), hist.column("hub_right_Fy")
+    demo.check("difference of the two hub forces / largest hub force (unstructured meshes: not mirror images)",
+               np.abs(left - right).max() / np.abs(left).max(), bound=0.02,
+               reference="symmetry of the model about x = 0")
+    return demo.finish()
+
+
+if __name__ == "__main__":
+    logging.basicConfig(level=logging.WARNING)
+    if os.environ.get("DC_LOG"):
+        logging.getLogger("dolfinx_corot.solvers.drivers").setLevel(logging.INFO)
+    main()

@@ -1,4 +1,11 @@
-"""Every demo is run (its verification cell asserts against its reference), serially and under MPI."""
+"""Every demo is run (its verification cell asserts against its reference), serially and under MPI.
+
+Serially, each demo module is imported and its ``main()`` called in this process: the returned
+report (``dolfinx_corot.gallery.Demo.finish``) must hold passed checks, each naming its reference,
+and the demo must have written a CSV history and a PNG. Under ``mpirun -n 2`` each demo runs as a
+script and must reproduce the values it recorded serially (``tip_values.json``).
+"""
+import importlib.util
 import json
 import os
 import subprocess
@@ -9,7 +16,8 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-DEMOS = sorted(p.stem for p in (ROOT / "demos").glob("*.py"))
+DEMO_DIR = ROOT / "demos"
+DEMOS = sorted(p.stem for p in DEMO_DIR.glob("*.py"))
 MPI_DEMOS = ["euler_beam_2d", "cantilever_rollup_2d", "lee_frame", "curved_beam_3d", "rollup_3d", "truss_dome_3d",
              "strip_rollup", "cylinder_pullout", "hinged_sphere", "slit_annular_plate", "stiffened_strip", "euler_continuum_2d", "euler_continuum_3d", "hertz_2d", "contact_patch_test", "two_wheels", "beam_on_soil_2d"]
 
@@ -23,6 +31,24 @@ def _run(cmd, outdir, timeout=900):
     return proc.stdout
 
 
+def _run_in_process(demo, outdir, monkeypatch):
+    """``main()`` of ``demos/<demo>.py``, imported under a private name; the environment of a CI run,
+    the demos folder on the path (a demo may import a neighbour), and sys.modules as before."""
+    monkeypatch.setenv("DC_OUTPUT_DIR", str(outdir))
+    monkeypatch.setenv("CI", os.environ.get("CI", "true"))
+    monkeypatch.syspath_prepend(str(DEMO_DIR))
+    before = set(sys.modules)
+    try:
+        spec = importlib.util.spec_from_file_location(f"_demo_{demo}", DEMO_DIR / f"{demo}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module.main()
+    finally:
+        for name in set(sys.modules) - before:
+            if str(getattr(sys.modules[name], "__file__", "") or "").startswith(str(DEMO_DIR)):
+                del sys.modules[name]
+
+
 @pytest.fixture(scope="module")
 def serial_outputs(tmp_path_factory):
     return tmp_path_factory.mktemp("serial")
@@ -30,11 +56,47 @@ def serial_outputs(tmp_path_factory):
 
 @pytest.mark.demo
 @pytest.mark.parametrize("demo", DEMOS)
-def test_demo_runs_and_verifies(demo, serial_outputs):
-    out = _run([sys.executable, f"demos/{demo}.py"], serial_outputs)
-    assert f"{demo}: verified" in out
+def test_demo_runs_and_verifies(demo, serial_outputs, monkeypatch):
+    report = _run_in_process(demo, serial_outputs, monkeypatch)
+    assert report["name"] == demo
+    assert report["checks"], f"{demo} verifies nothing"
+    for check in report["checks"]:
+        assert check["passed"], check
+        assert isinstance(check["reference"], str) and check["reference"].strip(), check
+    assert report["values"].get("load_factor"), "no values recorded for the MPI comparison"
     files = os.listdir(serial_outputs / demo)
     assert any(f.endswith(".csv") for f in files) and any(f.endswith(".png") for f in files), files
+    assert json.loads((serial_outputs / demo / "tip_values.json").read_text())["ranks"] == 1
+    plt = sys.modules.get("matplotlib.pyplot")
+    assert plt is None or not plt.get_fignums(), f"{demo} left pyplot figures open"
+
+
+def test_gallery_checks_name_their_reference_and_fail_loudly(tmp_path, monkeypatch):
+    """Demo.check: tolerances and bounds as documented, NaN fails, the reference is required."""
+    from dolfinx_corot.gallery import Demo, VerificationError
+
+    monkeypatch.setenv("DC_OUTPUT_DIR", str(tmp_path))
+    demo = Demo("harness")
+    demo.check("a", 1.0 + 1e-9, 1.0, rtol=1e-8, reference="r")
+    demo.check("b", [1, 2, 3], bound=3, reference="r")
+    demo.check("c", 0.5, bound=(0.0, None), reference="r")
+    demo.check("d", True, True, reference="r")
+    with pytest.raises(ValueError):
+        demo.check("no reference", 1.0, bound=2.0, reference=" ")
+    with pytest.raises(ValueError):
+        demo.check("neither expected nor bound", 1.0, reference="r")
+    demo.record(load_factor=np.arange(3.0))
+    report = demo.finish()
+    assert [c["passed"] for c in report["checks"]] == [True] * 4
+    assert json.loads((tmp_path / "harness" / "tip_values.json").read_text()) == {"load_factor": [0.0, 1.0, 2.0],
+                                                                                 "ranks": 1}
+    failing = Demo("harness_failures")
+    for value, kwargs in ((1.1, {"expected": 1.0, "rtol": 0.05}), (4, {"bound": 3}), (-1.0, {"bound": (0.0, 1.0)}),
+                          (float("nan"), {"bound": 1.0}), (float("nan"), {"expected": 0.0, "atol": 1.0})):
+        with pytest.raises(VerificationError, match="reference: r"):
+            failing.check("fails", value, reference="r", **kwargs)
+    with pytest.raises(VerificationError):
+        failing.finish()
 
 
 @pytest.mark.mpi

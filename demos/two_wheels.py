@@ -269,5 +269,5 @@ def main() -> dict:
 if __name__ == "__main__":
     logging.basicConfig(level=logging.WARNING)
     if os.environ.get("DC_LOG"):
-        logging.getLogger("dolfinx_corot.solvers.drivers").setLevel(logging.INFO)
+        logging.getLogger("dolfinx_corot.solvers.control").setLevel(logging.INFO)
     main()

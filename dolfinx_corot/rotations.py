@@ -44,8 +44,13 @@ and the stored angle may grow past :math:`2\pi` without loss (a beam rolled
 into two turns stores :math:`4\pi` at its tip).
 
 All functions are numba-compiled (``cache=True``) so that element kernels can
-call them; they take and return plain numpy arrays: vectors ``(3,)``,
-matrices ``(3, 3)``, quaternions ``(4,)`` as ``(w, x, y, z)``.
+call them; they take plain numpy arrays: vectors ``(3,)``, matrices
+``(3, 3)``, quaternions ``(4,)`` as ``(w, x, y, z)``. The SO(3) maps (exp,
+log, tangent maps and the 3 × 3 products) are complex-analytic: they are
+compiled for the dtype of their input and branch on real parts only, so that
+element kernels differentiate through them by complex step (Squire & Trapp
+1998). Given ``out``, they fill it instead of allocating (the kernels' hot
+loops) and return it.
 """
 from __future__ import annotations
 
@@ -53,19 +58,21 @@ import numba
 import numpy as np
 
 __all__ = [
-    "spin", "axial", "exp_so3", "log_so3", "tangent_so3", "tangent_inv_so3",
+    "spin", "axial", "dot", "cross", "matmul3", "matmul3_tn",
+    "exp_so3", "log_so3", "tangent_so3", "tangent_inv_so3",
     "compose", "update_so3", "quat_from_rotvec", "quat_to_matrix", "quat_from_matrix",
     "quat_mul", "quat_update", "rotvec_from_quat", "exp_so2", "log_so2", "update_so2",
     "orthogonality_error",
 ]
 
 _SMALL = 1e-3  # below this angle the 0/0 coefficients use their Taylor series
+_SMALL2 = 1e-6  # its square, compared with |w|² (no square root on the way)
 
 
 @numba.njit(cache=True)
 def spin(w):
     """Skew-symmetric matrix of ``w`` (3,): ``spin(w) @ v == cross(w, v)``."""
-    W = np.zeros((3, 3))
+    W = _like(w, (3, 3))
     W[0, 1] = -w[2]
     W[0, 2] = w[1]
     W[1, 0] = w[2]
@@ -81,107 +88,195 @@ def axial(W):
     return 0.5 * np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]])
 
 
-@numba.njit(cache=True)
-def _exp_coefficients(t):
-    """a = sin t / t, b = (1 - cos t)/t², both accurate for every t ≥ 0."""
-    if t < _SMALL:
-        t2 = t * t
+@numba.njit(cache=True, inline="always")
+def _like(x, shape):
+    """Zeros of the given shape in the floating type of ``x`` (float64, or complex128 in a complex step)."""
+    return np.zeros(shape, dtype=(x[:1] * 1.0).dtype)
+
+
+@numba.njit(cache=True, inline="always")
+def dot(a, b):
+    """a · b of two 3-vectors."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@numba.njit(cache=True, inline="always")
+def cross(a, b, out):
+    """out (3,) = a × b."""
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@numba.njit(cache=True, inline="always")
+def matmul3(A, B, out):
+    """out (3, 3) = A B (explicit loops: no BLAS call for tiny blocks)."""
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
+
+
+@numba.njit(cache=True, inline="always")
+def matmul3_tn(A, B, out):
+    """out (3, 3) = Aᵀ B."""
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = A[0, i] * B[0, j] + A[1, i] * B[1, j] + A[2, i] * B[2, j]
+
+
+@numba.njit(cache=True, inline="always")
+def _rodrigues_form(w, t2, a, b, out):
+    """out (3, 3) = I + a W + b W² with W = spin(w), t2 = |w|², using W² = w wᵀ − t2 I; returns
+    out (a new array if None).
+
+    exp, T and T⁻¹ all have this form; only the coefficients differ.
+    """
+    if out is None:
+        out = _like(w, (3, 3))
+    d = 1.0 - b * t2
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = b * w[i] * w[j]
+        out[i, i] += d
+    out[0, 1] -= a * w[2]
+    out[0, 2] += a * w[1]
+    out[1, 0] += a * w[2]
+    out[1, 2] -= a * w[0]
+    out[2, 0] -= a * w[1]
+    out[2, 1] += a * w[0]
+    return out
+
+
+@numba.njit(cache=True, inline="always")
+def _exp_coefficients(t2):
+    """a = sin t / t and b = (1 − cos t)/t² of t = √t2, both accurate for every t."""
+    if abs(t2.real) < _SMALL2:
         return 1.0 - t2 / 6.0 + t2 * t2 / 120.0, 0.5 - t2 / 24.0 + t2 * t2 / 720.0
+    t = np.sqrt(t2)
     s = np.sin(0.5 * t)
     # 1 - cos t = 2 sin²(t/2) has no cancellation
     return np.sin(t) / t, 2.0 * s * s / (t * t)
 
 
+@numba.njit(cache=True, inline="always")
+def exp_so3(w, out=None):
+    """Rotation tensor (3, 3) = exp(spin(w)) of the rotation vector ``w`` (3,) (Rodrigues formula)."""
+    t2 = dot(w, w)
+    a, b = _exp_coefficients(t2)
+    return _rodrigues_form(w, t2, a, b, out)
+
+
+@numba.njit(cache=True, inline="always")
+def _quaternion(R):
+    """(w, x, y, z) of ``R`` (3, 3) with w ≥ 0, of norm 1 up to the rounding of R (Spurrier 1978:
+    from the largest of tr R and the diagonal, so no branch loses digits); branches on real parts."""
+    tr = R[0, 0] + R[1, 1] + R[2, 2]
+    if tr.real >= R[0, 0].real and tr.real >= R[1, 1].real and tr.real >= R[2, 2].real:
+        w = 0.5 * np.sqrt(1.0 + tr)
+        f = 0.25 / w
+        return w, (R[2, 1] - R[1, 2]) * f, (R[0, 2] - R[2, 0]) * f, (R[1, 0] - R[0, 1]) * f
+    return _quaternion_from_diagonal(R, tr)
+
+
 @numba.njit(cache=True)
-def exp_so3(w):
-    """Rotation tensor (3, 3) of the rotation vector ``w`` (3,) (Rodrigues formula)."""
-    t = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-    a, b = _exp_coefficients(t)
-    W = spin(w)
-    return np.eye(3) + a * W + b * (W @ W)
+def _quaternion_from_diagonal(R, tr):
+    """:func:`_quaternion` when a diagonal term R_ii exceeds tr R (only beyond a quarter turn)."""
+    d0, d1, d2 = R[0, 0].real, R[1, 1].real, R[2, 2].real
+    m = max(d0, d1, d2)
+    i = 0
+    if d1 == m:
+        i = 1
+    elif d2 == m:
+        i = 2
+    j = (i + 1) % 3
+    k = (i + 2) % 3
+    qi = 0.5 * np.sqrt(1.0 + 2.0 * R[i, i] - tr)
+    f = 0.25 / qi
+    w = (R[k, j] - R[j, k]) * f
+    qj = (R[j, i] + R[i, j]) * f
+    qk = (R[k, i] + R[i, k]) * f
+    if i == 0:
+        x, y, z = qi, qj, qk
+    elif i == 1:
+        x, y, z = qk, qi, qj
+    else:
+        x, y, z = qj, qk, qi
+    if w.real < 0.0:
+        return -w, -x, -y, -z
+    return w, x, y, z
+
+
+@numba.njit(cache=True, inline="always")
+def _rotation_vector(w, x, y, z, th):
+    """th (3,) = rotation vector of the quaternion (w, x, y, z), w ≥ 0, of norm 1 up to rounding:
+    angle 2 atan(|v|/w) in [0, π] along v = (x, y, z); returns th."""
+    s2 = x * x + y * y + z * z
+    if abs(s2.real) < 1e-16:
+        # t/s = (2/w)·atan(s/w)/(s/w) = (2/w)(1 − s²/(3w²)) + O(s⁴): exact to rounding here
+        c = (2.0 / w) * (1.0 - s2 / (3.0 * w * w))
+    else:
+        s = np.sqrt(s2)
+        if w.real >= s.real:
+            c = 2.0 * np.arctan(s / w) / s
+        else:  # beyond a quarter turn: atan(s/w) = π/2 − atan(w/s), no division by a small w
+            c = (np.pi - 2.0 * np.arctan(w / s)) / s
+    th[0] = c * x
+    th[1] = c * y
+    th[2] = c * z
+    return th
 
 
 @numba.njit(cache=True)
 def quat_from_matrix(R):
     """Unit quaternion (4,) ``(w, x, y, z)`` of ``R`` (3, 3), with w ≥ 0 (Spurrier 1978)."""
-    tr = R[0, 0] + R[1, 1] + R[2, 2]
-    q = np.empty(4)
-    m = max(tr, R[0, 0], R[1, 1], R[2, 2])
-    if m == tr:
-        q[0] = 0.5 * np.sqrt(1.0 + tr)
-        f = 0.25 / q[0]
-        q[1] = (R[2, 1] - R[1, 2]) * f
-        q[2] = (R[0, 2] - R[2, 0]) * f
-        q[3] = (R[1, 0] - R[0, 1]) * f
-    else:
-        i = 0
-        if R[1, 1] == m:
-            i = 1
-        elif R[2, 2] == m:
-            i = 2
-        j = (i + 1) % 3
-        k = (i + 2) % 3
-        qi = 0.5 * np.sqrt(1.0 + 2.0 * R[i, i] - tr)
-        f = 0.25 / qi
-        q[1 + i] = qi
-        q[0] = (R[k, j] - R[j, k]) * f
-        q[1 + j] = (R[j, i] + R[i, j]) * f
-        q[1 + k] = (R[k, i] + R[i, k]) * f
-    if q[0] < 0.0:
-        q = -q
+    w, x, y, z = _quaternion(R)
+    q = np.array([w, x, y, z])
     return q / np.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2 + q[3] ** 2)
 
 
 @numba.njit(cache=True)
 def rotvec_from_quat(q):
     """Rotation vector (3,) of the unit quaternion ``q`` (4,), with norm in [0, π]."""
-    w = q[0]
-    v = q[1:4].copy()
-    if w < 0.0:
-        w = -w
-        v = -v
-    s = np.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2)
-    t = 2.0 * np.arctan2(s, w)  # in [0, π]
-    if s < 1e-8:
-        # t/s = (2/w)·atan(s/w)/(s/w) = (2/w)(1 − s²/(3w²)) + O(s⁴): exact to rounding here
-        return v * (2.0 / w) * (1.0 - s * s / (3.0 * w * w))
-    return v * (t / s)
+    if q[0].real < 0.0:
+        return _rotation_vector(-q[0], -q[1], -q[2], -q[3], _like(q, 3))
+    return _rotation_vector(q[0], q[1], q[2], q[3], _like(q, 3))
 
 
-@numba.njit(cache=True)
-def log_so3(R):
-    """Rotation vector (3,) of ``R`` (3, 3), with norm in [0, π]; robust near 0 and π."""
-    return rotvec_from_quat(quat_from_matrix(R))
+@numba.njit(cache=True, inline="always")
+def log_so3(R, out=None):
+    """Rotation vector (3,) = log(R) of ``R`` (3, 3), with norm in [0, π]; robust near 0 and π."""
+    if out is None:
+        out = _like(R, 3)
+    w, x, y, z = _quaternion(R)
+    return _rotation_vector(w, x, y, z, out)
 
 
-@numba.njit(cache=True)
-def tangent_so3(w):
+@numba.njit(cache=True, inline="always")
+def tangent_so3(w, out=None):
     """Spatial tangent operator T(w) (3, 3): δR Rᵀ = spin(T(w) δw) for R = exp(w)."""
-    t = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-    W = spin(w)
-    if t < _SMALL:
-        t2 = t * t
+    t2 = dot(w, w)
+    if abs(t2.real) < _SMALL2:
         b = 0.5 - t2 / 24.0 + t2 * t2 / 720.0
         c = 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0
     else:
+        t = np.sqrt(t2)
         s = np.sin(0.5 * t)
         b = 2.0 * s * s / (t * t)
         c = (t - np.sin(t)) / (t * t * t)
-    return np.eye(3) + b * W + c * (W @ W)
+    return _rodrigues_form(w, t2, b, c, out)
 
 
-@numba.njit(cache=True)
-def tangent_inv_so3(w):
-    """Inverse of :func:`tangent_so3` (3, 3); singular only at |w| = 2π, 4π, …"""
-    t = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-    W = spin(w)
-    if t < _SMALL:
-        t2 = t * t
+@numba.njit(cache=True, inline="always")
+def tangent_inv_so3(w, out=None):
+    """Inverse of :func:`tangent_so3` (3, 3), I − ½W + (1 − (t/2)cot(t/2))/t² W²; singular only at
+    |w| = 2π, 4π, …"""
+    t2 = dot(w, w)
+    if abs(t2.real) < _SMALL2:
         c = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0
     else:
-        h = 0.5 * t
-        c = (1.0 - h * np.cos(h) / np.sin(h)) / (t * t)
-    return np.eye(3) - 0.5 * W + c * (W @ W)
+        h = 0.5 * np.sqrt(t2)
+        c = (1.0 - h * np.cos(h) / np.sin(h)) / t2
+    return _rodrigues_form(w, t2, -0.5, c, out)
 
 
 @numba.njit(cache=True)

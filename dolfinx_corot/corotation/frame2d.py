@@ -35,6 +35,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from .transform import force
+
 
 @numba.njit(cache=True, inline="always")
 def initial(x1, y1, x2, y2):
@@ -89,8 +91,7 @@ def fill_projector(l, c, s, P):
 @numba.njit(cache=True, inline="always")
 def global_force(P, fbar, f):
     """f (6,) = Pᵀ f̄."""
-    for i in range(6):
-        f[i] = P[0, i] * fbar[0] + P[1, i] * fbar[1] + P[2, i] * fbar[2]
+    force(P, fbar, f, 3, 6)
 
 
 @numba.njit(cache=True, inline="always")

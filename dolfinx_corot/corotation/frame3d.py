@@ -31,6 +31,7 @@ is the spin of the element frame in its own axes,
 :math:`\mathbf p` and :math:`\mathbf p_i = \mathbf R_i\mathbf R_0\mathbf j`). Then
 :math:`\mathbf f = \mathbf B^T\bar{\mathbf f}`.
 
+The rotation algebra (exp, log, T⁻¹) is that of :mod:`dolfinx_corot.rotations`.
 Every function here is complex-analytic in the configuration, so that the
 consistent tangent :math:`\mathbf K = \partial\mathbf f/\partial\mathbf d` (material and
 geometric parts, i.e. :math:`\mathbf B^T\bar{\mathbf K}\mathbf B + \partial\mathbf B^T/\partial\mathbf d:\bar{\mathbf f}`)
@@ -43,86 +44,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-
-@numba.njit(cache=True, inline="always")
-def dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-@numba.njit(cache=True, inline="always")
-def cross(a, b, out):
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
-
-
-@numba.njit(cache=True)
-def exp_spin(w, R):
-    """R = exp(spin(w)) (Rodrigues), complex-analytic; series below |w|² = 1e-6."""
-    t2 = dot(w, w)
-    if abs(t2.real) < 1e-6:
-        a = 1.0 - t2 / 6.0 + t2 * t2 / 120.0
-        b = 0.5 - t2 / 24.0 + t2 * t2 / 720.0
-    else:
-        t = np.sqrt(t2)
-        a = np.sin(t) / t
-        b = (1.0 - np.cos(t)) / t2
-    # I + aW + bW² with W² = w wᵀ − |w|² I
-    d = 1.0 - b * t2
-    for i in range(3):
-        for j in range(3):
-            R[i, j] = b * w[i] * w[j]
-        R[i, i] += d
-    R[0, 1] -= a * w[2]
-    R[0, 2] += a * w[1]
-    R[1, 0] += a * w[2]
-    R[1, 2] -= a * w[0]
-    R[2, 0] -= a * w[1]
-    R[2, 1] += a * w[0]
-
-
-@numba.njit(cache=True)
-def log_rotation(R, th):
-    """th (3,) = log(R) for a rotation below π (an element-frame rotation), complex-analytic."""
-    tr = R[0, 0] + R[1, 1] + R[2, 2]
-    w = 0.5 * np.sqrt(1.0 + tr)
-    f = 0.25 / w
-    v0 = (R[2, 1] - R[1, 2]) * f
-    v1 = (R[0, 2] - R[2, 0]) * f
-    v2 = (R[1, 0] - R[0, 1]) * f
-    s2 = v0 * v0 + v1 * v1 + v2 * v2
-    if abs(s2.real) < 1e-16:
-        c = (2.0 / w) * (1.0 - s2 / (3.0 * w * w))
-    else:
-        s = np.sqrt(s2)
-        c = 2.0 * np.arctan(s / w) / s
-    th[0] = c * v0
-    th[1] = c * v1
-    th[2] = c * v2
-
-
-@numba.njit(cache=True)
-def tangent_inverse(th, Ti):
-    """Ti = T⁻¹(th) = I − ½Θ + (1 − (t/2)cot(t/2))/t² Θ² (spatial form), complex-analytic."""
-    t2 = dot(th, th)
-    if abs(t2.real) < 1e-6:
-        c = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0
-    else:
-        t = np.sqrt(t2)
-        h = 0.5 * t
-        c = (1.0 - h * np.cos(h) / np.sin(h)) / t2
-    # I − ½Θ + cΘ² with Θ² = θθᵀ − |θ|² I
-    d = 1.0 - c * t2
-    for i in range(3):
-        for j in range(3):
-            Ti[i, j] = c * th[i] * th[j]
-        Ti[i, i] += d
-    Ti[0, 1] += 0.5 * th[2]
-    Ti[0, 2] -= 0.5 * th[1]
-    Ti[1, 0] -= 0.5 * th[2]
-    Ti[1, 2] += 0.5 * th[0]
-    Ti[2, 0] += 0.5 * th[1]
-    Ti[2, 1] -= 0.5 * th[0]
+from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
+from .transform import rotate_columns
 
 
 @numba.njit(cache=True)
@@ -144,22 +67,6 @@ def initial_frame(X1, X2, v, R0):
         R0[i, 1] = e2[i]
         R0[i, 2] = e3[i]
     return l0
-
-
-@numba.njit(cache=True, inline="always")
-def _mat3(A, B, C):
-    """C = A B for 3×3 arrays (explicit loops: no BLAS call for tiny blocks)."""
-    for i in range(3):
-        for j in range(3):
-            C[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
-
-
-@numba.njit(cache=True, inline="always")
-def _mat3_tn(A, B, C):
-    """C = Aᵀ B for 3×3 arrays."""
-    for i in range(3):
-        for j in range(3):
-            C[i, j] = A[0, i] * B[0, j] + A[1, i] * B[1, j] + A[2, i] * B[2, j]
 
 
 @numba.njit(cache=True)
@@ -197,12 +104,12 @@ def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
     for i in range(3):
         for j in range(3):
             R0c[i, j] = R0[i, j]
-    _mat3_tn(Rr, R1, T)
-    _mat3(T, R0c, Rb)
-    log_rotation(Rb, th1)
-    _mat3_tn(Rr, R2, T)
-    _mat3(T, R0c, Rb)
-    log_rotation(Rb, th2)
+    matmul3_tn(Rr, R1, T)
+    matmul3(T, R0c, Rb)
+    log_so3(Rb, th1)
+    matmul3_tn(Rr, R2, T)
+    matmul3(T, R0c, Rb)
+    log_so3(Rb, th2)
     ubar = (l * l - l0 * l0) / (l + l0)
     # local components of p, p1, p2 (only the first two are needed)
     pl0 = dot(e1, p)
@@ -225,15 +132,11 @@ def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
     Bl[0, 6] = 1.0
     Ti = np.empty((3, 3), dtype=dt)
     for i in range(2):
-        tangent_inverse(th1 if i == 0 else th2, Ti)
+        tangent_inv_so3(th1 if i == 0 else th2, Ti)
         for r in range(3):
             for c in range(12):
                 Bl[1 + 3 * i + r, c] = -(Ti[r, 0] * GT[0, c] + Ti[r, 1] * GT[1, c] + Ti[r, 2] * GT[2, c])
             for k in range(3):
                 Bl[1 + 3 * i + r, 3 + 6 * i + k] += Ti[r, k]
-    for r in range(7):
-        for blk in range(4):
-            c0 = 3 * blk
-            for j in range(3):
-                B[r, c0 + j] = Bl[r, c0] * Rr[j, 0] + Bl[r, c0 + 1] * Rr[j, 1] + Bl[r, c0 + 2] * Rr[j, 2]
+    rotate_columns(Bl, Rr, B, 7, 12)
     return ubar

@@ -33,7 +33,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .frame3d import cross, dot
+from ..rotations import cross, dot
+from .transform import frame_axes, local_coordinates, positions
 
 
 @numba.njit(cache=True)
@@ -47,39 +48,25 @@ def frame(x, R):
     e3 = n / np.sqrt(dot(n, n))
     m = d1 / np.sqrt(dot(d1, d1)) - d2 / np.sqrt(dot(d2, d2))
     e1 = m / np.sqrt(dot(m, m))
-    e2 = np.empty(3, dtype=dt)
-    cross(e3, e1, e2)
-    for k in range(3):
-        R[k, 0] = e1[k]
-        R[k, 1] = e2[k]
-        R[k, 2] = e3[k]
+    frame_axes(e1, e3, R)
 
 
 @numba.njit(cache=True)
 def initial(X, R0, xbar0):
     """Initial frame R0 (3, 3) and local node coordinates xbar0 (4, 3) about the centroid."""
     frame(X, R0)
-    c = (X[0] + X[1] + X[2] + X[3]) / 4.0
-    for a in range(4):
-        for k in range(3):
-            xbar0[a, k] = R0[0, k] * (X[a, 0] - c[0]) + R0[1, k] * (X[a, 1] - c[1]) + R0[2, k] * (X[a, 2] - c[2])
+    local_coordinates(R0, X, xbar0)
 
 
 @numba.njit(cache=True)
 def basic(X, u, xbar0, dbar, B):
     """In-plane deformational displacements dbar (8,) = (ū_a, v̄_a) and B = ∂d̄/∂u (8, 12)."""
     dt = u.dtype
-    x = np.empty((4, 3), dtype=dt)
-    for a in range(4):
-        for k in range(3):
-            x[a, k] = X[a, k] + u[a, k]
+    x = positions(X, u)
     R = np.empty((3, 3), dtype=dt)
     frame(x, R)
-    c = (x[0] + x[1] + x[2] + x[3]) / 4.0
     xbar = np.empty((4, 3), dtype=dt)
-    for a in range(4):
-        for k in range(3):
-            xbar[a, k] = R[0, k] * (x[a, 0] - c[0]) + R[1, k] * (x[a, 1] - c[1]) + R[2, k] * (x[a, 2] - c[2])
+    local_coordinates(R, x, xbar)
     for a in range(4):
         dbar[2 * a] = xbar[a, 0] - xbar0[a, 0]
         dbar[2 * a + 1] = xbar[a, 1] - xbar0[a, 1]

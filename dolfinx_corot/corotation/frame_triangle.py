@@ -37,7 +37,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .frame3d import _mat3, _mat3_tn, cross, dot, log_rotation, tangent_inverse
+from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
+from .transform import frame_axes, linear_force, local_coordinates, positions, rotate_columns, stiffness
 
 
 @numba.njit(cache=True)
@@ -51,13 +52,7 @@ def frame(x, R):
     n = np.empty(3, dtype=dt)
     cross(a, b, n)
     nn = np.sqrt(dot(n, n))
-    e3 = n / nn
-    e2 = np.empty(3, dtype=dt)
-    cross(e3, e1, e2)
-    for k in range(3):
-        R[k, 0] = e1[k]
-        R[k, 1] = e2[k]
-        R[k, 2] = e3[k]
+    frame_axes(e1, n / nn, R)
     return l, dot(b, e1), nn / l
 
 
@@ -65,10 +60,7 @@ def frame(x, R):
 def initial(X, R0, xbar0):
     """Initial frame R0 (3, 3) and local node coordinates xbar0 (3, 3) about the centroid."""
     frame(X, R0)
-    c = (X[0] + X[1] + X[2]) / 3.0
-    for a in range(3):
-        for k in range(3):
-            xbar0[a, k] = R0[0, k] * (X[a, 0] - c[0]) + R0[1, k] * (X[a, 1] - c[1]) + R0[2, k] * (X[a, 2] - c[2])
+    local_coordinates(R0, X, xbar0)
 
 
 @numba.njit(cache=True)
@@ -82,17 +74,11 @@ def parts(X, u, R, R0, xbar0, rotations=True):
     Complex-analytic in u and R (the dtype of u is used throughout).
     """
     dt = u.dtype
-    x = np.empty((3, 3), dtype=dt)
-    for a in range(3):
-        for k in range(3):
-            x[a, k] = X[a, k] + u[a, k]
+    x = positions(X, u)
     Rr = np.empty((3, 3), dtype=dt)
     l, b1, b2 = frame(x, Rr)
-    c = (x[0] + x[1] + x[2]) / 3.0
     xbar = np.empty((3, 3), dtype=dt)
-    for a in range(3):
-        for k in range(3):
-            xbar[a, k] = Rr[0, k] * (x[a, 0] - c[0]) + Rr[1, k] * (x[a, 1] - c[1]) + Rr[2, k] * (x[a, 2] - c[2])
+    local_coordinates(Rr, x, xbar)
     R0c = np.empty((3, 3), dtype=dt)
     for i in range(3):
         for j in range(3):
@@ -108,10 +94,10 @@ def parts(X, u, R, R0, xbar0, rotations=True):
             for i in range(3):
                 for j in range(3):
                     Ra[i, j] = R[a, i, j]
-            _mat3_tn(Rr, Ra, T)
-            _mat3(T, R0c, Rb)
-            log_rotation(Rb, th[a])
-            tangent_inverse(th[a], Ti[a])
+            matmul3_tn(Rr, Ra, T)
+            matmul3(T, R0c, Rb)
+            log_so3(Rb, th[a])
+            tangent_inv_so3(th[a], Ti[a])
         for k in range(3):
             dbar[6 * a + k] = xbar[a, k] - xbar0[a, k]
             dbar[6 * a + 3 + k] = th[a, k]
@@ -159,12 +145,7 @@ def basic(X, u, R, R0, xbar0, dbar, B, rotations=True):
     Rr, l, b1, b2, xbar, th, Ti, Om, Bl, d = parts(X, u, R, R0, xbar0, rotations)
     for r in range(18):
         dbar[r] = d[r]
-    # columns back to global components: block·Rrᵀ
-    for r in range(18):
-        for blk in range(6):
-            c0 = 3 * blk
-            for j in range(3):
-                B[r, c0 + j] = Bl[r, c0] * Rr[j, 0] + Bl[r, c0 + 1] * Rr[j, 1] + Bl[r, c0 + 2] * Rr[j, 2]
+    rotate_columns(Bl, Rr, B, 18, 18)  # columns back to global components
 
 
 @numba.njit(cache=True)
@@ -174,10 +155,9 @@ def _dTiT_m(th, m, M):
     thc = np.empty(3, dtype=np.complex128)
     Tc = np.empty((3, 3), dtype=np.complex128)
     for j in range(3):
-        for k in range(3):
-            thc[k] = th[k]
+        thc[:] = th
         thc[j] += 1j * h
-        tangent_inverse(thc, Tc)
+        tangent_inv_so3(thc, Tc)
         for i in range(3):
             M[i, j] = (Tc[0, i] * m[0] + Tc[1, i] * m[1] + Tc[2, i] * m[2]).imag / h
 
@@ -194,32 +174,10 @@ def force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K, rotations=True):
     """
     Rr, l, b1, b2, xbar, th, Ti, Om, Bl, dbar = parts(X, u, R, R0, xbar0, rotations)
     fbar = np.empty(18)
-    for i in range(18):
-        acc = 0.0
-        for j in range(18):
-            acc += Kbar[i, j] * dbar[j]
-        fbar[i] = acc
-    g = np.zeros(18)
-    for r in range(18):
-        fr = fbar[r]
-        if fr != 0.0:
-            for i in range(18):
-                g[i] += Bl[r, i] * fr
-    # material part Blᵀ K̄ Bl
-    KB = np.zeros((18, 18))
-    for r in range(18):
-        for j in range(18):
-            acc = 0.0
-            for s in range(18):
-                acc += Kbar[r, s] * Bl[s, j]
-            KB[r, j] = acc
-    Kl = np.zeros((18, 18))
-    for i in range(18):
-        for j in range(18):
-            acc = 0.0
-            for r in range(18):
-                acc += Bl[r, i] * KB[r, j]
-            Kl[i, j] = acc
+    g = np.empty(18)
+    linear_force(Bl, Kbar, dbar, fbar, g, 18, 18)
+    Kl = np.empty((18, 18))
+    stiffness(Bl, Kbar, Kl, 18, 18)  # material part
     # − S(g) Ω: block b rows 3b..3b+2 get −spin(g_b) Ω
     for b in range(6):
         g0, g1, g2 = g[3 * b], g[3 * b + 1], g[3 * b + 2]
@@ -297,12 +255,7 @@ def force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K, rotations=True):
         for k in range(3):
             f[3 * b + k] = Rr[k, 0] * g[3 * b] + Rr[k, 1] * g[3 * b + 1] + Rr[k, 2] * g[3 * b + 2]
     tmp = np.empty((18, 18))
-    for i in range(18):
-        for bc in range(6):
-            for k in range(3):
-                # (K^l Λ)[i, 3bc+k] = Σ_m K^l[i, 3bc+m] Rrᵀ[m, k] = Σ_m K^l[i, 3bc+m] Rr[k, m]
-                tmp[i, 3 * bc + k] = (Kl[i, 3 * bc] * Rr[k, 0] + Kl[i, 3 * bc + 1] * Rr[k, 1]
-                                      + Kl[i, 3 * bc + 2] * Rr[k, 2])
+    rotate_columns(Kl, Rr, tmp, 18, 18)  # K^l Λ
     for br in range(6):
         for k in range(3):
             for j in range(18):

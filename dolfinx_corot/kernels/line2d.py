@@ -6,7 +6,8 @@ r"""Two-node line elements in the plane (beam and bar): gather ► frame ► law
 element in the initial frame (no co-rotational work at all).
 
 For DOLFINx the two are wrapped in numba ``cfunc`` tabulate-tensor kernels
-(:data:`vector_kernel`, :data:`matrix_kernel`) with the ufcx signature
+(:data:`vector_kernel`, :data:`matrix_kernel`, from
+:func:`dolfinx_corot.kernels.ufcx.tabulate_tensor_kernels`) with the ufcx signature
 ``(A, w, c, coords, entity_local_index, permutation)``:
 
 * ``w`` = [state of node 1 (u, v, θ), state of node 2, props (NPROPS)],
@@ -21,8 +22,9 @@ import numba
 import numpy as np
 
 from ..corotation import frame2d
+from ..corotation.transform import stiffness
 from ..elements import line2d as law
-from .ufcx import signature
+from .ufcx import tabulate_tensor_kernels
 
 NDOF = 6
 NCOEF = NDOF + law.NPROPS
@@ -55,13 +57,7 @@ def linear(x1, y1, x2, y2, d, props, f, K, P, fbar, kbar):
         t2 += P[2, j] * d[j]
     law.basic_response(l0, ub, t1, t2, props, fbar, kbar, False)
     frame2d.global_force(P, fbar, f)
-    for i in range(6):
-        for j in range(6):
-            acc = 0.0
-            for a in range(3):
-                for b in range(3):
-                    acc += P[a, i] * kbar[a, b] * P[b, j]
-            K[i, j] = acc
+    stiffness(P, kbar, K, 3, 6)
 
 
 @numba.njit(cache=True)
@@ -92,24 +88,9 @@ def evaluate_all(X, D, props, large_rotations, F, K):
 
 
 @numba.njit(cache=True, inline="always")
-def _tabulate(w_, c_, coords_, f, K):
-    w = numba.carray(w_, (NCOEF,))
-    c = numba.carray(c_, (1,))
-    X = numba.carray(coords_, (2, 3))
+def _tabulate(w, c, X, f, K, tangent):
+    """The element function of the DOLFINx kernels (see :mod:`.ufcx`); K is cheap, always filled."""
     evaluate(X[0, 0], X[0, 1], X[1, 0], X[1, 1], w[:NDOF], w[NDOF:], c[0] != 0.0, f, K)
 
 
-@numba.cfunc(signature, nopython=True, cache=True)
-def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
-    """Element internal-force vector (6,) for a DOLFINx linear form."""
-    b = numba.carray(b_, (NDOF,))
-    K = np.empty((NDOF, NDOF))
-    _tabulate(w_, c_, coords_, b, K)
-
-
-@numba.cfunc(signature, nopython=True, cache=True)
-def matrix_kernel(A_, w_, c_, coords_, entity_local_index, permutation):
-    """Element tangent (6, 6) for a DOLFINx bilinear form."""
-    A = numba.carray(A_, (NDOF, NDOF))
-    f = np.empty(NDOF)
-    _tabulate(w_, c_, coords_, f, A)
+vector_kernel, matrix_kernel = tabulate_tensor_kernels(_tabulate, NDOF, NCOEF, 2)

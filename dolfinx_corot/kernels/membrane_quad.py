@@ -17,8 +17,10 @@ import numba
 import numpy as np
 
 from ..corotation import frame_quad as frame
+from ..corotation.transform import linear_force, stiffness
 from ..elements import membrane_quad as law
-from .ufcx import signature
+from .spatial import H, pack_constants, unpack_constants
+from .ufcx import tabulate_tensor_kernels
 
 NNODE = 4
 NDOF = 6 * NNODE
@@ -26,7 +28,6 @@ NSTATE = 7
 NEDATA = 9 + 12 + 64           # R0, x̄0, K̄ (computed once per cell)
 NCOEF = NNODE * NSTATE + law.NPROPS + NEDATA
 CCW = np.array([0, 1, 3, 2])   # DOLFINx vertex order → counter-clockwise
-H = 1e-30
 _P0 = NNODE * NSTATE
 _E0 = _P0 + law.NPROPS
 
@@ -39,9 +40,7 @@ def element_data(X, props, out):
     frame.initial(X, R0, xbar0)
     K = np.empty((8, 8))
     law.local_stiffness(np.ascontiguousarray(xbar0[:, :2]), props, K)
-    out[:9] = R0.ravel()
-    out[9:21] = xbar0.ravel()
-    out[21:] = K.ravel()
+    pack_constants(R0, xbar0, K, out)
 
 
 @numba.njit(cache=True)
@@ -63,16 +62,7 @@ def _force(X, u, xbar0, Kbar, f):
     B = np.empty((8, 12), dtype=dt)
     frame.basic(X, u, xbar0, dbar, B)
     fbar = np.empty(8, dtype=dt)
-    for i in range(8):
-        acc = Kbar[i, 0] * dbar[0]
-        for j in range(1, 8):
-            acc += Kbar[i, j] * dbar[j]
-        fbar[i] = acc
-    for i in range(12):
-        acc = B[0, i] * fbar[0]
-        for r in range(1, 8):
-            acc += B[r, i] * fbar[r]
-        f[i] = acc
+    linear_force(B, Kbar, dbar, fbar, f, 8, 12)
 
 
 @numba.njit(cache=True)
@@ -100,7 +90,7 @@ def linear(X, u, R0, xbar0, Kbar, f, K):
     dbar = np.empty(8)
     B = np.empty((8, 12))
     frame.basic(X, z, xbar0, dbar, B)
-    K[:, :] = B.T @ Kbar @ B
+    stiffness(B, Kbar, K, 8, 12)
     f[:] = K @ u.ravel()
 
 
@@ -119,9 +109,7 @@ def evaluate(X, S, props, large_rotations, f24, K24):
 
 @numba.njit(cache=True)
 def _evaluate_ccw(Xc, u, edata, large_rotations, tangent, f24, K24):
-    R0 = edata[:9].copy().reshape(3, 3)
-    xbar0 = edata[9:21].copy().reshape(4, 3)
-    Kbar = edata[21:].copy().reshape(8, 8)
+    R0, xbar0, Kbar = unpack_constants(edata, 4, 8)
     f = np.empty(12)
     K = np.empty((12, 12))
     if large_rotations and not tangent:
@@ -144,35 +132,15 @@ def _evaluate_ccw(Xc, u, edata, large_rotations, tangent, f24, K24):
 
 
 @numba.njit(cache=True, inline="always")
-def _tabulate(w_, c_, coords_, tangent, f, K):
-    w = numba.carray(w_, (NCOEF,))
-    c = numba.carray(c_, (1,))
-    X = numba.carray(coords_, (4, 3))
+def _tabulate(w, c, X, f, K, tangent):
+    """The element function of the DOLFINx kernels (see :mod:`.ufcx`)."""
     Xc = np.empty((4, 3))
     u = np.empty((4, 3))
     for a in range(4):
         for k in range(3):
             Xc[a, k] = X[CCW[a], k]
             u[a, k] = w[NSTATE * CCW[a] + k]
-    _evaluate_ccw(Xc, u, w[_E0:].copy(), c[0] != 0.0, tangent, f, K)
+    _evaluate_ccw(Xc, u, w[_E0:], c[0] != 0.0, tangent, f, K)
 
 
-@numba.cfunc(signature, nopython=True, cache=True)
-def vector_kernel(b_, w_, c_, coords_, entity_local_index, permutation):
-    """Element internal-force vector (24,) for a DOLFINx linear form."""
-    b = numba.carray(b_, (NDOF,))
-    f = np.empty(NDOF)
-    K = np.empty((NDOF, NDOF))
-    _tabulate(w_, c_, coords_, False, f, K)
-    for i in range(NDOF):
-        b[i] = f[i]
-
-
-@numba.cfunc(signature, nopython=True, cache=True)
-def matrix_kernel(A_, w_, c_, coords_, entity_local_index, permutation):
-    """Element tangent (24, 24) for a DOLFINx bilinear form."""
-    A = numba.carray(A_, (NDOF, NDOF))
-    f = np.empty(NDOF)
-    K = np.empty((NDOF, NDOF))
-    _tabulate(w_, c_, coords_, True, f, K)
-    A[:, :] = K
+vector_kernel, matrix_kernel = tabulate_tensor_kernels(_tabulate, NDOF, NCOEF, NNODE)

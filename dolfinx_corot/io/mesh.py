@@ -109,6 +109,14 @@ class TaggedMesh:
             return None
         return self.facet_tags.indices[self.facet_tags.values == tag]
 
+    def pin_point_groups(self) -> None:
+        """Address the groups of nodes found by their coordinates by their input node numbers
+        from now on (before the mesh nodes move, e.g. to a new reference configuration)."""
+        for name in list(self.points):
+            if name not in self.node_ids:
+                self.node_ids[name] = _input_nodes_of_vertices(self.mesh, _locate_vertices(self.mesh,
+                                                                                           self.points[name]))
+
     def vertices(self, name: str) -> np.ndarray:
         """Local vertex indices (owned and ghost) of the nodes of group ``name`` (any dim)."""
         dim, _ = self._check(name)
@@ -123,6 +131,19 @@ class TaggedMesh:
             return _vertices_of_input_nodes(self.mesh, self.node_ids[name])
         pts = self.points[name]
         return _locate_vertices(self.mesh, pts)
+
+
+def _input_nodes_of_vertices(mesh: dolfinx.mesh.Mesh, vertices: np.ndarray) -> np.ndarray:
+    """Input node numbers of local vertices, gathered from every rank (P1 geometry)."""
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim, 0)
+    c2v = mesh.topology.connectivity(tdim, 0).array
+    node_of_vertex = np.empty(mesh.topology.index_map(0).size_local + mesh.topology.index_map(0).num_ghosts,
+                              dtype=np.int64)
+    node_of_vertex[c2v] = mesh.geometry.dofmap.array
+    inputs = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)
+    local = inputs[node_of_vertex[np.asarray(vertices, dtype=np.int64)]]
+    return np.unique(np.concatenate(mesh.comm.allgather(local)))
 
 
 def _vertices_of_input_nodes(mesh: dolfinx.mesh.Mesh, ids: np.ndarray) -> np.ndarray:

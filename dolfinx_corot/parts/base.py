@@ -102,6 +102,7 @@ class Part:
     dof_names: tuple[str, ...]
     translations: int
     state_size: int
+    state = None               # the configuration (a Function; made by each part)
     continuum = False          # a solid (UFL forms) rather than a structure
     coupled = False            # one mesh (Coupled: several)
     _displacement_out = None   # output Functions, made on first use

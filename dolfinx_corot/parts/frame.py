@@ -114,6 +114,28 @@ class LineFrame(Part):
         bad = np.flatnonzero(lengths <= 1e-10 * scale)
         self._refuse(cells, bad, start, f"{label}: {{n}} element(s) of zero length, the first at {{at}}")
 
+    def capture_reference(self) -> None:
+        """Take the current configuration as the stress-free reference of the elements: the part's
+        mesh nodes move to their current positions, displacements restart from zero and nodal
+        rotations from the identity, and the element frames and per-cell constants follow from
+        the new positions (the forms are rebuilt). A structure added in a deformed configuration
+        (seed §3.1.2, approach II) is captured so; its displacements then measure U − U_os.
+        At creation the reference is the mesh itself."""
+        if self.state is None:
+            return Part.capture_reference(self)
+        self.tmesh.pin_point_groups()  # groups found by position: by node number from now on
+        geo = self.tmesh.mesh.geometry
+        node = np.empty(len(geo.x), dtype=np.int64)  # the block of V at each geometry node
+        node[geo.dofmap.array] = self.V.dofmap.list.array
+        geo.x[:, : self.gdim] += self.translations_of(node)
+        self._reset_state()
+        self._forms = None
+        Part.capture_reference(self)
+
+    def _reset_state(self) -> None:
+        """Displacements zero, rotations the identity."""
+        self.state.x.array[:] = 0.0
+
     def add_truss(self, where, area, material, prestress_force) -> PartRef:
         return self.add_bars(where, material.E * area, float(prestress_force))
 
@@ -224,8 +246,12 @@ class Rotations3D:
     def _init_state(self) -> None:
         S = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("Lagrange", 1), dim=kernels3d.NSTATE)
         self.state = dolfinx.fem.Function(S, name="state")
-        self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, 3] = 1.0  # identity rotations
+        self._reset_state()
         self._disp = dolfinx.fem.Function(self.V, name="displacement")
+
+    def _reset_state(self) -> None:
+        self.state.x.array[:] = 0.0
+        self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, 3] = 1.0  # identity rotations
 
     def update(self, dx: PETSc.Vec) -> None:
         """u ← u + du; q ← exp(dw)∘q (multiplicative, spatial) on owned nodes; ghosts from their owners."""

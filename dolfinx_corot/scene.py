@@ -164,12 +164,15 @@ class Scene:
             raise ValueError(f"fix '{where}': unknown dof(s) {bad}; this part has {names}")
         model.fix(where, tuple(names.index(d) for d in dofs))
 
-    def prescribe(self, part: PartRef, where: str, amplitude=None, **values: float) -> None:
-        """Prescribed displacement/rotation at the nodes of ``where``, scaled by the load factor
-        (or by ``amplitude(λ)``, a :class:`dolfinx_corot.Amplitude`).
+    def prescribe(self, part: PartRef, where: str, amplitude=None, **values) -> None:
+        """Prescribed displacement/rotation at the nodes of ``where``: a number scaled by the load
+        factor (or by ``amplitude(λ)``, a :class:`dolfinx_corot.Amplitude`), or a function
+        ``motion(load_factor, stage)`` of the load factor and the construction stage (None
+        outside staged analyses).
 
         Example: ``scene.prescribe(beam, "tip", uy=-1.0)`` (displacement control:
-        λ = 1 moves the tip by −1; read the force with :meth:`monitor_reaction`).
+        λ = 1 moves the tip by −1; read the force with :meth:`monitor_reaction`);
+        ``scene.prescribe(beam, "tip", uy=lambda lam, stage: -0.1 * lam**2)``.
         """
         model = part.model
         names = model.dof_names
@@ -177,6 +180,12 @@ class Scene:
         if bad or not values:
             raise ValueError(f"prescribe '{where}': give one or more of {names} as keywords; got {list(values)}")
         for dof, value in values.items():
+            if callable(value):
+                if amplitude is not None:
+                    raise ValueError(f"prescribe '{where}': {dof} is a function of the load factor already; "
+                                     "an amplitude does not apply to it")
+                model.prescribe(where, names.index(dof), 0.0, None, function=value)
+                continue
             if not np.isfinite(value):
                 raise ValueError(f"prescribe '{where}': {dof} = {value} is not finite")
             model.prescribe(where, names.index(dof), float(value), amplitude)

@@ -93,3 +93,29 @@ def test_field_output_for_paraview(member, tmp_path):
         x = f["Mesh/mesh/geometry"][:]
     tip = np.argmax(x[:, 0])
     assert abs(u[tip, 1] - res.history.column("tip_uy")[-1]) < 1e-14
+
+
+def test_prescribed_motion_as_a_function_of_the_load_factor(member):
+    """A motion given as a function m(λ, stage) is followed exactly (the tip sits at m(λ) at every
+    step), and equals the same path given as a piecewise-linear amplitude at the steps' load factors."""
+    def motion(lam, stage):
+        return 0.4 * L * np.sin(np.pi * lam / 2.0) ** 2
+
+    lams = np.linspace(0.25, 2.0, 8)
+    runs = []
+    for prescribed in (motion, dc.Amplitude([(0.0, 0.0)] + [(x, motion(x, None) / (0.4 * L)) for x in lams])):
+        sc = dc.Scene()
+        m = sc.add_beam(member, "m", section=dc.Rectangle(B, H), material=dc.Elastic(E), orientation=(0, 1, 0))
+        sc.fix(m, "base")
+        if callable(prescribed) and not isinstance(prescribed, dc.Amplitude):
+            sc.prescribe(m, "tip", uy=prescribed)
+        else:
+            sc.prescribe(m, "tip", uy=0.4 * L, amplitude=prescribed)
+        sc.monitor("tip", m, "tip")
+        sc.monitor_reaction("jack", m, "tip")
+        runs.append(dc.solve(sc, dc.LoadControl(load_factors=lams)).history)
+    np.testing.assert_allclose(runs[0].column("tip_uy"), [motion(x, None) for x in lams], rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(runs[0].column("jack_Fy"), runs[1].column("jack_Fy"), rtol=1e-9)
+    assert abs(runs[0].column("jack_Fy")).max() > 0.0
+    with pytest.raises(ValueError, match="function of the load factor already"):
+        sc.prescribe(m, "tip", uy=motion, amplitude=dc.Amplitude([(0, 0), (1, 1)]))

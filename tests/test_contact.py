@@ -465,10 +465,9 @@ def test_an_idle_interface_changes_nothing_and_builds_no_matrix():
         assert np.abs(results[0] - results[1]).max() < 1e-14, np.abs(results[0] - results[1]).max()
 
 
-def _beam_on_soil_deflection(refine):
-    """Mid-span deflection of the beam of test_beam_on_a_soil_block on a mesh ``refine`` times
-    finer (soil and beam), its nodes slaves of the soil, the gaps closed to 1e-8 h."""
-    F = 5.0
+def _beam_on_soil_scene(refine=1):
+    """The beam (depth 0.2, 12·refine elements) on the soil block (16·refine × 4·refine cells) of
+    test_beam_on_a_soil_block, pressed by F = 5 at mid-span; no contact yet."""
     soil_mesh = rectangles({"soil": (0.0, -1.0, 4.0, 1.0, 16 * refine, 4 * refine)},
                            {"soil_base": [("soil", "bottom")], "soil_top": [("soil", "top")]}, comm=comm)
     n = 12 * refine
@@ -481,8 +480,15 @@ def _beam_on_soil_deflection(refine):
     beam = sc.add_beam(beam_mesh, section=dc.Rectangle(1.0, 0.2), material=dc.Elastic(1.0e4, 0.3))
     sc.fix(soil, "soil_base")
     sc.fix(beam, "left", dofs=("ux",))
-    sc.load(beam, "mid", force=(0.0, -F))
+    sc.load(beam, "mid", force=(0.0, -5.0))
     sc.monitor("mid", beam, "mid")
+    return sc, soil, beam
+
+
+def _beam_on_soil_deflection(refine):
+    """Mid-span deflection of the beam of test_beam_on_a_soil_block on a mesh ``refine`` times
+    finer (soil and beam), its nodes slaves of the soil, the gaps closed to 1e-8 h."""
+    sc, soil, beam = _beam_on_soil_scene(refine)
     sc.contact(slaves=(beam, "beam"), masters=(soil, "soil_top"), law=dc.AugmentedLagrangian(gap_tolerance=1e-8))
     return dc.solve(sc, dc.LoadControl(steps=2)).history.column("mid_uy")[-1]
 
@@ -503,21 +509,8 @@ def test_beam_on_a_soil_block(direction, beam_on_soil_convergence):
     as h² to a reference extrapolated from meshes 2, 4 and 8 times finer."""
     from dolfinx_corot.assembly import make_system
 
-    F = 5.0
-    soil_mesh = rectangles({"soil": (0.0, -1.0, 4.0, 1.0, 16, 4)},
-                           {"soil_base": [("soil", "bottom")], "soil_top": [("soil", "top")]}, comm=comm)
-    xb = np.linspace(0.5, 3.5, 13)
-    beam_mesh = dc.io.mesh.from_arrays(np.column_stack([xb, np.full_like(xb, 0.1)]),
-                                       np.column_stack([np.arange(12), np.arange(1, 13)]), "beam",
-                                       point_groups={"left": np.array([0]), "mid": np.array([6])}, comm=comm)
-    sc = dc.Scene()
-    soil = sc.add_solid(soil_mesh, material=dc.SaintVenantKirchhoff(100.0, 0.3), degree=1)
-    beam = sc.add_beam(beam_mesh, section=dc.Rectangle(1.0, 0.2), material=dc.Elastic(1.0e4, 0.3))
-    sc.fix(soil, "soil_base")
-    sc.fix(beam, "left", dofs=("ux",))
-    sc.load(beam, "mid", force=(0.0, -F))
+    sc, soil, beam = _beam_on_soil_scene()
     sc.monitor_reaction("base", soil, "soil_base")
-    sc.monitor("mid", beam, "mid")
     law = dc.AugmentedLagrangian()
     if direction == "beam master":
         made = sc.contact(slaves=(soil, "soil_top"), masters=(beam, "beam"), law=law)

@@ -145,6 +145,8 @@ def test_contact_errors_name_the_culprit():
         sc.contact(slaves=(b, "upper_bottom"), masters=(b, "upper"))
     with pytest.raises(ValueError, match="penalty must be positive"):
         sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), law=dc.Penalty(penalty=-1.0))
+    with pytest.raises(dc.ContactError, match="'lower_top' with itself"):
+        sc.contact(slaves=(b, "lower_top"), masters=(b, "lower_top"))
     tm2 = _two_blocks(2, 3)
     sc2 = dc.Scene()
     b2 = sc2.add_solid(tm2, material=dc.SaintVenantKirchhoff(E, NU), degree=2)

@@ -166,3 +166,22 @@ def test_checkpoint_in_a_folder_that_cannot_be_made_fails_before_the_first_step(
         dc.solve(_cantilever(), dc.LoadControl(steps=2), checkpoint=blocker + "/sub/run.npz",
                  on_step=steps.append)
     assert steps == []
+
+
+def test_restart_refuses_a_solid_whose_reference_was_captured_differently(tmp_path):
+    """A solid's captured reference (its reference shift) is part of the scene's fingerprint."""
+    def solid(shifted):
+        tm = rectangles({"block": (0.0, 0.0, 1.0, 1.0, 2, 2)}, {"bottom": [("block", "bottom")]}, comm=comm)
+        sc = dc.Scene()
+        b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(1.0, 0.3), degree=1)
+        sc.fix(b, "bottom")
+        sc.gravity(b, (0.0, -1.0), 1e-3)
+        if shifted:
+            sc.model.capture_reference(0.1 * sc.model.V.tabulate_dof_coordinates()[:, :2].ravel())
+        return sc
+
+    path = _shared(tmp_path, "solid.npz")
+    dc.solve(solid(True), dc.LoadControl(steps=1), checkpoint=path)
+    with pytest.raises(dc.CheckpointError, match="reference_shift"):
+        dc.solve(solid(False), dc.LoadControl(steps=2), restart=path)
+    assert dc.solve(solid(True), dc.LoadControl(steps=2), restart=path).completed

@@ -22,6 +22,8 @@ and dX' = det(I + ∇_X w) dX. While w = 0 the forms are those on the mesh itsel
 """
 from __future__ import annotations
 
+import hashlib
+
 import numpy as np
 import ufl
 from mpi4py import MPI
@@ -108,6 +110,15 @@ class Solid(AdditiveState, Part):
 
     def _materials(self) -> list:
         return self._regions
+
+    def describe(self) -> dict:
+        """The part's description, with a hash of its reference shift (a captured reference)."""
+        out = super().describe()
+        if self._shifted:
+            shift = self.to_global(self.reference_shift.x.array)
+            digest = hashlib.sha256(np.ascontiguousarray(shift).tobytes()).hexdigest() if self.comm.rank == 0 else None
+            out["reference_shift"] = self.comm.bcast(digest, root=0)
+        return out
 
     def _entities(self, where: str) -> tuple[int, np.ndarray]:
         """(dim, local entities) that locate the dofs of group ``where``: its facets when it is a

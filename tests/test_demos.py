@@ -25,6 +25,8 @@ MPI_DEMOS = ["euler_beam_2d", "cantilever_rollup_2d", "lee_frame", "curved_beam_
 def _run(cmd, outdir, timeout=900):
     env = dict(os.environ, DC_OUTPUT_DIR=str(outdir), CI=os.environ.get("CI", "true"),
                OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
+               # unbuffered: output still in a buffer at exit may be lost once MPI has finalized
+               PYTHONUNBUFFERED="1",
                OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     proc = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=timeout)
     assert proc.returncode == 0, f"{' '.join(map(str, cmd))} failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"

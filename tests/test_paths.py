@@ -82,8 +82,10 @@ def test_field_output_for_paraview(member, tmp_path):
     """XDMF/HDF5 output: the stored displacement of the last step equals the monitored tip value."""
     import h5py
 
+    from mpi4py import MPI
+
     sc = _scene(member, [(np.array([0.0, 1e-2, 0.0]), None, None)])
-    path = str(tmp_path / "member.xdmf")
+    path = MPI.COMM_WORLD.bcast(str(tmp_path / "member.xdmf"), root=0)  # one file for all ranks
     with dc.io.FieldWriter(sc, path) as writer:
         res = dc.solve(sc, dc.LoadControl(steps=3), on_step=writer)
     with h5py.File(path.replace(".xdmf", ".h5"), "r") as f:

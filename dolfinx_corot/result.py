@@ -29,9 +29,16 @@ class History:
         return cols
 
     def column(self, name: str) -> np.ndarray:
-        """Values of one column as an array (nan where a row lacks it)."""
+        """Values of one column as an array (nan where a row lacks it). The ``residuals`` column
+        (the residual norms of each step's Newton iterations, a text of numbers per row) is an
+        object array of float arrays, one per step."""
         if self.rows and all(name not in r for r in self.rows):
             raise KeyError(f"no column '{name}' in the history; columns: {self.columns}")
+        if name == "residuals":
+            out = np.empty(len(self.rows), dtype=object)
+            for i, r in enumerate(self.rows):
+                out[i] = np.array([float(v) for v in str(r.get(name, "")).split()])
+            return out
         return np.array([r.get(name, np.nan) for r in self.rows], dtype=float)
 
     def to_csv(self, path: str) -> None:

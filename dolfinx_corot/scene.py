@@ -242,14 +242,21 @@ class Scene:
         ``name_ux``, ``name_uy``, … In 2D ``name_rz`` is the total angle (it may exceed 2π);
         in 3D ``name_rx..rz`` is the rotation vector of the nodal rotation (norm ≤ π)."""
         part.model.nodal_values(where)  # fails early for a missing group
-        self.monitors.append(Monitor(name, part, where))
+        self._add_monitor(Monitor(name, part, where))
+
+    def _add_monitor(self, monitor: Monitor) -> None:
+        taken = [m for m in self.monitors if m.name == monitor.name and m.kind == monitor.kind]
+        if taken:
+            raise ValueError(f"monitor '{monitor.name}' exists already (on group '{taken[0].where}'): give each "
+                             "monitor a name of its own (its history columns carry it)")
+        self.monitors.append(monitor)
 
     def monitor_reaction(self, name: str, part: PartRef, where: str) -> None:
         """Record the force (sum over the nodes of ``where``) that the supports or prescribed
         displacements there exert on the structure, after every step: name_Fx, name_Fy, name_Mz
         (2D) or name_Fx … name_Mz (3D)."""
         part.model.tmesh.vertices(where)  # fails early for a missing group
-        self.monitors.append(Monitor(name, part, where, "reaction"))
+        self._add_monitor(Monitor(name, part, where, "reaction"))
 
     # -- introspection -----------------------------------------------------------
     @property

@@ -143,7 +143,7 @@ def test_contact_errors_name_the_culprit():
         sc.contact(slaves=(b, "nowhere"), masters=(b, "lower_top"))
     with pytest.raises(dc.ContactError, match="upper"):
         sc.contact(slaves=(b, "upper_bottom"), masters=(b, "upper"))
-    with pytest.raises(ValueError, match="penalty must be positive"):
+    with pytest.raises(ValueError, match="penalty = -1.0 must be a finite number > 0"):
         sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), law=dc.Penalty(penalty=-1.0))
     with pytest.raises(dc.ContactError, match="'lower_top' with itself"):
         sc.contact(slaves=(b, "lower_top"), masters=(b, "lower_top"))

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .. import validate
 from ..parts.surface import SurfaceError
 
 ContactError = SurfaceError  # a contact surface that cannot be built (missing group, unsupported part)
@@ -26,6 +27,11 @@ class Penalty:
 
     augmented = False
 
+    def __post_init__(self):
+        name = type(self).__name__
+        validate.positive(name, "penalty", self.penalty, allow_none=True)
+        validate.positive(name, "factor", self.factor)
+
 
 @dataclass(frozen=True)
 class AugmentedLagrangian(Penalty):
@@ -36,3 +42,8 @@ class AugmentedLagrangian(Penalty):
     max_updates: int = 10
 
     augmented = True
+
+    def __post_init__(self):
+        super().__post_init__()
+        validate.positive("AugmentedLagrangian", "gap_tolerance", self.gap_tolerance)
+        validate.whole("AugmentedLagrangian", "max_updates", self.max_updates, 0)

@@ -6,6 +6,8 @@ answers ``part.surface(group)`` with a :class:`~.surface.Surface`. :func:`part_f
 chooses the part model a mesh carries; nothing outside this package asks for a
 concrete part class.
 """
+import numpy as np
+
 from .base import Motion, Part, PartRef, global_sum, owned_dofs_of_vertices
 from .coupled import Coupled
 from .frame import Frame2D, Frame3D, LineFrame
@@ -22,6 +24,12 @@ def part_for_mesh(tmesh, large_rotations: bool, solid_degree: int | None = None)
     (lines: 2D or 3D frames; triangles in space: shells and membranes; quadrilaterals in space:
     membranes)."""
     mesh = tmesh.mesh
+    x = mesh.geometry.x
+    bad = np.flatnonzero(~np.isfinite(x).all(axis=1))
+    found = mesh.comm.allgather(x[bad[0]].tolist() if len(bad) else None)
+    if any(f is not None for f in found):
+        raise ValueError(f"the mesh has node coordinates that are not finite, e.g. {next(f for f in found if f)}: "
+                         "check the geometry (gmsh model or arrays) before building parts on it")
     if solid_degree is not None:
         return Solid(tmesh, solid_degree, large_rotations)
     if mesh.topology.dim == mesh.geometry.dim and mesh.topology.dim > 1:

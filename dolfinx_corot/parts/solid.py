@@ -54,9 +54,10 @@ class Solid(AdditiveState, Part):
         mesh = tmesh.mesh
         cell = mesh.topology.cell_name()
         if cell not in CELLS or mesh.topology.dim != mesh.geometry.dim:
+            advice = (f"read the gmsh model with from_gmsh(model, gdim={mesh.topology.dim})"
+                      if mesh.topology.dim > 1 else "a mesh of lines carries beams or bars (add_beam, add_truss)")
             raise ValueError(f"solids need a mesh of {CELLS} filling its space (tdim = gdim); got {cell} with "
-                             f"tdim {mesh.topology.dim}, gdim {mesh.geometry.dim}: read the gmsh model with "
-                             f"from_gmsh(model, gdim={mesh.topology.dim})")
+                             f"tdim {mesh.topology.dim}, gdim {mesh.geometry.dim}: {advice}")
         if degree not in (1, 2):
             raise ValueError(f"solid: degree {degree} is not 1 or 2")
         self.tmesh = tmesh

@@ -20,6 +20,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from .. import validate
 from ..result import Result
 from .newton import NewtonOptions, NewtonReport, Stepper, newton, solve_step
 from .run import CheckpointError, Run
@@ -44,6 +45,15 @@ class LoadControl:
     max_cuts: int = 8
     extrapolate: bool = False
     newton: NewtonOptions = NewtonOptions()
+
+    def __post_init__(self):
+        validate.whole("LoadControl", "steps", self.steps, 1)
+        validate.whole("LoadControl", "max_cuts", self.max_cuts, 0)
+        if self.load_factors is None and not (isinstance(self.final, (int, float)) and math.isfinite(self.final)
+                                              and self.final != 0.0):
+            raise ValueError(f"LoadControl: final = {self.final!r} must be a finite load factor other than 0 "
+                             "(the start)")
+        self.targets()
 
     def targets(self) -> np.ndarray:
         """The load factors to reach in turn (any order: they may decrease, to unload)."""
@@ -210,6 +220,20 @@ class ArcLength:
     max_growth: float = 1.5
     max_cuts: int = 8
     newton: NewtonOptions = field(default_factory=NewtonOptions)
+
+    def __post_init__(self):
+        validate.whole("ArcLength", "max_steps", self.max_steps, 1)
+        validate.whole("ArcLength", "max_cuts", self.max_cuts, 0)
+        validate.whole("ArcLength", "desired_iterations", self.desired_iterations, 1)
+        if not (isinstance(self.initial_increment, (int, float)) and math.isfinite(self.initial_increment)
+                and self.initial_increment != 0.0):
+            raise ValueError(f"ArcLength: initial_increment = {self.initial_increment!r} must be a finite "
+                             "number other than 0")
+        for name in ("min_length", "max_length"):
+            validate.positive("ArcLength", name, getattr(self, name), allow_none=True)
+        validate.positive("ArcLength", "psi", self.psi, allow_zero=True)
+        if not self.max_growth >= 1.0:
+            raise ValueError(f"ArcLength: max_growth = {self.max_growth!r} must be ≥ 1")
 
     def describe(self) -> dict:
         d = {k: v for k, v in asdict(self).items() if k not in ("stop", "newton")}

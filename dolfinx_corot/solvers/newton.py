@@ -23,6 +23,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import validate
+
 logger = logging.getLogger(__name__)
 
 
@@ -66,6 +68,19 @@ class NewtonOptions:
     forcing_max: float = 1e-2
     forcing_gamma: float = 0.9
     preconditioner: str = "step"
+
+    def __post_init__(self):
+        for name in ("rtol", "atol", "xtol"):
+            validate.positive("NewtonOptions", name, getattr(self, name), allow_zero=True)
+        if self.rtol == 0.0 and self.atol == 0.0:
+            raise ValueError("NewtonOptions: rtol and atol are both 0: no residual can converge")
+        validate.whole("NewtonOptions", "max_iterations", self.max_iterations, 1)
+        validate.whole("NewtonOptions", "max_growth", self.max_growth, 1)
+        validate.whole("NewtonOptions", "line_search_trials", self.line_search_trials, 0)
+        validate.positive("NewtonOptions", "divergence_factor", self.divergence_factor)
+        if self.preconditioner not in ("step", "iteration"):
+            raise ValueError(f"NewtonOptions: preconditioner = {self.preconditioner!r} is not 'step' or "
+                             "'iteration'")
 
 
 @dataclass
@@ -129,6 +144,12 @@ def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin:
         system.begin_step()  # before the first residual: contributions' before_solve hooks
     norm, ref = system.residual(stepper.load_factor)
     report.residuals.append(norm)
+    if not (math.isfinite(norm) and math.isfinite(ref)):
+        # loads or a configuration beyond floating point: no tolerance can judge this residual
+        report.reason = (f"the residual is not finite (|r| = {norm:.3e}, load and internal force norm "
+                         f"{ref:.3e}): the loads or the configuration overflow")
+        report.load_factor = stepper.load_factor
+        return report
     scale = max(norm, ref)
     growth = 0
     small_correction = False

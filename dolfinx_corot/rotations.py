@@ -242,6 +242,15 @@ def rotvec_from_quat(q):
     return _rotation_vector(q[0], q[1], q[2], q[3], _like(q, 3))
 
 
+@numba.njit(cache=True)
+def rotvecs_from_quats(Q):
+    """Rotation vectors (n, 3) of the unit quaternions ``Q`` (n, 4), each with norm in [0, π]."""
+    out = np.empty((Q.shape[0], 3))
+    for i in range(Q.shape[0]):
+        out[i] = rotvec_from_quat(Q[i])
+    return out
+
+
 @numba.njit(cache=True, inline="always")
 def log_so3(R, out=None):
     """Rotation vector (3,) = log(R) of ``R`` (3, 3), with norm in [0, π]; robust near 0 and π."""

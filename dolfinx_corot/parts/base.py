@@ -265,10 +265,12 @@ class Part:
             space = dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1)) if nr == 1 else \
                 dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=nr)
             self._rotation_out = dolfinx.fem.Function(space, name="rotation")
-        st = self.state.x.array.reshape(-1, self.state_size)
-        values = np.array([self._dof_values(row)[self.translations:] for row in st]).reshape(len(st), nr)
-        self._rotation_out.x.array[:] = values.ravel()
+        self._rotation_out.x.array[:] = self._rotation_values().ravel()
         return self._rotation_out
+
+    def _rotation_values(self) -> np.ndarray:
+        """(blocks, ndof − translations) nodal rotations; a state that is the dofs holds them."""
+        return self.state.x.array.reshape(-1, self.state_size)[:, self.translations: self.ndof]
 
     def reaction(self, where: str, values: np.ndarray) -> np.ndarray:
         """Sum over the nodes of ``where`` of an assembled nodal vector given as local array of V (all ranks)."""

@@ -274,6 +274,11 @@ class Rotations3D:
     def _dof_values(s: np.ndarray) -> np.ndarray:
         return np.concatenate([s[:3], rotations.rotvec_from_quat(s[3:7].copy())])
 
+    def _rotation_values(self) -> np.ndarray:
+        """Rotation vectors (blocks, 3) of the nodal quaternions (norm ≤ π)."""
+        st = self.state.x.array.reshape(-1, kernels3d.NSTATE)
+        return rotations.rotvecs_from_quats(np.ascontiguousarray(st[:, 3:7]))
+
     def prescribe(self, where: str, comp: int, value: float, amplitude=None, function=None) -> None:
         if comp >= self.translations and (value != 0.0 or function is not None):
             raise NotImplementedError(f"prescribe '{where}': non-zero rotations ({self.dof_names[comp]}) "

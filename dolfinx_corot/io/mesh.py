@@ -4,9 +4,15 @@
 ``dolfinx.io.gmshio.model_to_mesh``) and distributes it; physical-group
 names travel with it so that supports, loads and monitors say
 ``where="tip"`` instead of a tag number. Groups of the highest dimension
-become cell tags; groups of points (and, for 2D/3D meshes, of facets) are
-located on every rank by the coordinates of their nodes, so that a node may
-belong to several groups.
+become cell tags (and, one dimension lower, facet tags); every group of a
+lower (or, for a mesh of lower dimension, higher) dimension also keeps the
+gmsh node tags of its nodes, which are the mesh's input node numbers (tag − 1,
+as ``gmshio.model_to_mesh`` numbers them). A group therefore addresses its
+own nodes only, never a node of another body that shares its position (two
+bodies meshed apart that start in contact), and a node may belong to several
+groups. Only nodes that no cell of the mesh uses (a gmsh point not embedded
+in the surface) and groups added with :meth:`TaggedMesh.add_point_group` are
+located by their coordinates.
 """
 from __future__ import annotations
 
@@ -31,10 +37,13 @@ class TaggedMesh:
     """A DOLFINx mesh with named groups.
 
     mesh: the DOLFINx mesh; cell_tags: its cell MeshTags (gmsh physical tags);
-    groups: name → (dim, physical tag); points: name → (n, 3) coordinates of
-    the nodes of each group of dimension < tdim, the same on every rank;
-    node_ids: name → input node numbers, which take precedence over the
-    coordinates (nodes that share a position, as on the two sides of a slit).
+    groups: name → (dim, physical tag). The nodes of a group of another
+    dimension than the cells are its ``node_ids`` (name → input node numbers:
+    the gmsh node tags − 1, or the indices given to :func:`from_arrays`) and its
+    ``points`` (name → (n, 3) coordinates, the same on every rank) of nodes
+    located by position (:meth:`add_point_group`; gmsh nodes that no cell
+    uses). Input numbers tell apart nodes that share a position (the two
+    sides of a slit, two bodies that touch).
     node_source: meshes with the same source number their nodes alike (the
     gmsh node tags of one gmsh model): parts on such meshes share the nodes
     they have in common (a beam stiffening a shell).
@@ -65,18 +74,35 @@ class TaggedMesh:
         self.extra_cells[name] = picked
         self.groups[name] = (tdim, -1)
 
-    def add_point_group(self, name: str, points) -> None:
-        """A group of nodes located by their coordinates (n, 3) (e.g. a loaded point)."""
+    def add_point_group(self, name: str, points, within: str | None = None) -> None:
+        """A group of the nodes at the coordinates ``points`` (n, gdim) (e.g. a loaded point), one
+        node at each; ``within``: a group whose nodes alone are candidates (the body meant where
+        two bodies have nodes at one position). The nodes are found now and addressed by their
+        input numbers from then on."""
         if name in self.groups:
             raise ValueError(f"group '{name}' exists already")
         pts = np.atleast_2d(np.asarray(points, dtype=float))
+        gdim = self.mesh.geometry.dim
+        if pts.ndim != 2 or not 1 <= pts.shape[1] <= 3 or not np.all(np.isfinite(pts)):
+            raise ValueError(f"point group '{name}': give finite coordinates (n, {gdim}), got {pts.tolist()}")
         full = np.zeros((len(pts), 3))
         full[:, : pts.shape[1]] = pts
-        self.points[name] = full
+        vertices = _locate_vertices(self.mesh, full)
+        if within is not None:
+            vertices = np.intersect1d(vertices, self.vertices(within))
+        owned = vertices[vertices < self.mesh.topology.index_map(0).size_local]
+        from scipy.spatial import cKDTree
+        x = dolfinx.mesh.compute_midpoints(self.mesh, 0, owned.astype(np.int32)) if len(owned) else np.zeros((0, 3))
+        which = cKDTree(full[:, :gdim]).query(x[:, :gdim], k=1)[1] if len(owned) else np.zeros(0, dtype=int)
+        count = self.mesh.comm.allreduce(np.bincount(which, minlength=len(full)))
+        scope = f" among the nodes of '{within}'" if within is not None else ""
+        if np.any(count == 0):
+            raise ValueError(f"point group '{name}': no node{scope} at {pts[count == 0].tolist()}")
+        if np.any(count > 1):
+            raise ValueError(f"point group '{name}': {int(count.max())} nodes{scope} at {pts[count > 1][0].tolist()} "
+                             "(bodies meshed apart share the position): give within=<a group of the body meant>")
+        self.node_ids[name] = _input_nodes_of_vertices(self.mesh, vertices)
         self.groups[name] = (0, -1)
-        if self.mesh.comm.allreduce(len(self.vertices(name))) == 0:
-            del self.points[name], self.groups[name]
-            raise ValueError(f"point group '{name}': no node at {pts.tolist()}")
 
     @property
     def tdim(self) -> int:
@@ -110,53 +136,67 @@ class TaggedMesh:
         return self.facet_tags.indices[self.facet_tags.values == tag]
 
     def pin_point_groups(self) -> None:
-        """Address the groups of nodes found by their coordinates by their input node numbers
-        from now on (before the mesh nodes move, e.g. to a new reference configuration)."""
+        """Address the nodes found by their coordinates by their input node numbers from now on
+        (before the mesh nodes move, e.g. to a new reference configuration)."""
         for name in list(self.points):
-            if name not in self.node_ids:
-                self.node_ids[name] = _input_nodes_of_vertices(self.mesh, _locate_vertices(self.mesh,
-                                                                                           self.points[name]))
+            found = _input_nodes_of_vertices(self.mesh, _locate_vertices(self.mesh, self.points.pop(name)))
+            self.node_ids[name] = np.union1d(self.node_ids.get(name, np.zeros(0, dtype=np.int64)), found)
 
     def vertices(self, name: str) -> np.ndarray:
         """Local vertex indices (owned and ghost) of the nodes of group ``name`` (any dim)."""
         dim, _ = self._check(name)
         if dim == self.tdim:
-            self.mesh.topology.create_connectivity(self.tdim, 0)
-            c2v = self.mesh.topology.connectivity(self.tdim, 0)
-            cells = self.cells(name)
-            counts = np.diff(c2v.offsets)[cells]
-            idx = np.repeat(c2v.offsets[cells], counts) + _ramp(counts)
-            return np.unique(c2v.array[idx]).astype(np.int32)
+            return self._closure(self.tdim, self.cells(name))
+        if name not in self.node_ids and name not in self.points and self.facets(name) is not None:
+            return self._closure(self.tdim - 1, self.facets(name))  # a facet group known by its tags only
+        found = [np.zeros(0, dtype=np.int32)]
         if name in self.node_ids:
-            return _vertices_of_input_nodes(self.mesh, self.node_ids[name])
-        pts = self.points[name]
-        return _locate_vertices(self.mesh, pts)
+            found.append(_vertices_of_input_nodes(self.mesh, self.node_ids[name]))
+        if name in self.points:
+            found.append(_locate_vertices(self.mesh, self.points[name]))
+        return np.unique(np.concatenate(found)).astype(np.int32)
+
+    def _closure(self, dim: int, entities: np.ndarray) -> np.ndarray:
+        """The vertices of local entities of dimension ``dim``."""
+        self.mesh.topology.create_connectivity(dim, 0)
+        e2v = self.mesh.topology.connectivity(dim, 0)
+        counts = np.diff(e2v.offsets)[entities]
+        idx = np.repeat(e2v.offsets[entities], counts) + _ramp(counts)
+        return np.unique(e2v.array[idx]).astype(np.int32)
+
+
+def _vertex_geometry_nodes(mesh: dolfinx.mesh.Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices, geometry nodes) of every local cell's corners, matched pairwise (the first
+    geometry nodes of a cell are its vertices, in the same order, also for curved cells)."""
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim, 0)
+    c2v = mesh.topology.connectivity(tdim, 0)
+    ncells = len(c2v.offsets) - 1
+    nv = len(c2v.array) // max(ncells, 1)
+    gdofs = mesh.geometry.dofmap.array.reshape(ncells, -1)[:, :nv] if ncells else np.zeros(0, dtype=np.int32)
+    return c2v.array, np.asarray(gdofs).ravel()
 
 
 def _input_nodes_of_vertices(mesh: dolfinx.mesh.Mesh, vertices: np.ndarray) -> np.ndarray:
-    """Input node numbers of local vertices, gathered from every rank (P1 geometry)."""
-    tdim = mesh.topology.dim
-    mesh.topology.create_connectivity(tdim, 0)
-    c2v = mesh.topology.connectivity(tdim, 0).array
+    """Input node numbers of local vertices, gathered from every rank."""
+    verts, nodes = _vertex_geometry_nodes(mesh)
     node_of_vertex = np.empty(mesh.topology.index_map(0).size_local + mesh.topology.index_map(0).num_ghosts,
                               dtype=np.int64)
-    node_of_vertex[c2v] = mesh.geometry.dofmap.array
+    node_of_vertex[verts] = nodes
     inputs = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)
     local = inputs[node_of_vertex[np.asarray(vertices, dtype=np.int64)]]
-    return np.unique(np.concatenate(mesh.comm.allgather(local)))
+    return np.unique(np.concatenate(mesh.comm.allgather(local))).astype(np.int64)
 
 
 def _vertices_of_input_nodes(mesh: dolfinx.mesh.Mesh, ids: np.ndarray) -> np.ndarray:
-    """Local vertices (owned and ghost) of the input nodes ``ids`` (P1 geometry: node = vertex)."""
-    tdim = mesh.topology.dim
-    mesh.topology.create_connectivity(tdim, 0)
-    c2v = mesh.topology.connectivity(tdim, 0).array
-    gdofs = mesh.geometry.dofmap.array
-    vertex_of_node = np.empty(len(mesh.geometry.x), dtype=np.int32)
-    vertex_of_node[gdofs] = c2v
+    """Local vertices (owned and ghost) of the input nodes ``ids`` (nodes that are no vertex, such
+    as the mid-side nodes of curved cells, are skipped)."""
+    verts, nodes = _vertex_geometry_nodes(mesh)
+    vertex_of_node = np.full(len(mesh.geometry.x), -1, dtype=np.int32)
+    vertex_of_node[nodes] = verts
     inputs = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)
-    nodes = np.flatnonzero(np.isin(inputs, np.asarray(ids, dtype=np.int64)))
-    return np.unique(vertex_of_node[nodes]).astype(np.int32)
+    found = vertex_of_node[np.flatnonzero(np.isin(inputs, np.asarray(ids, dtype=np.int64)))]
+    return np.unique(found[found >= 0]).astype(np.int32)
 
 
 def _ramp(counts: np.ndarray) -> np.ndarray:
@@ -195,11 +235,16 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
     """
     groups: dict[str, tuple[int, int]] = {}
     points: dict[str, np.ndarray] = {}
+    node_ids: dict[str, np.ndarray] = {}
     error = None
     if comm.rank == rank:
         phys = model.getPhysicalGroups()
         if not phys:
             error = "the gmsh model has no physical groups: add at least one for the cells"
+        node_tags = np.sort(np.asarray(model.mesh.getNodes()[0], dtype=np.int64))
+        if not error and not np.array_equal(node_tags, np.arange(1, len(node_tags) + 1)):
+            error = ("the gmsh node tags are not 1..n (the mesh's input node numbers are the tags − 1): call "
+                     "gmsh.model.mesh.renumberNodes() before from_gmsh")
         tdim = max((d for d, _ in phys), default=0) if dim is None else int(dim)
         if not error and not any(d == tdim for d, _ in phys):
             error = f"the gmsh model has no physical group of dimension {tdim} (cells to build a mesh of)"
@@ -215,14 +260,25 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
                             error = (f"cells belong to two physical groups, '{seen[int(e)]}' and '{name}': "
                                      "each cell must be in exactly one group of its dimension")
                         seen[int(e)] = name
+        # the nodes of the mesh: those of the cells (elements of the physical groups of dimension tdim)
+        in_mesh = np.zeros(len(node_tags) + 1, dtype=bool)
+        for d, tag in phys:
+            if d == tdim and not error:
+                for entity in model.getEntitiesForPhysicalGroup(d, tag):
+                    for enodes in model.mesh.getElements(d, entity)[2]:
+                        in_mesh[np.asarray(enodes, dtype=np.int64)] = True
         for d, tag in phys:
             name = model.getPhysicalName(d, tag) or f"{d}:{tag}"
             if name in groups:
                 error = f"physical group name '{name}' is used twice (dims {groups[name][0]} and {d})"
             groups[name] = (d, tag)
-            if d != tdim:
+            if d != tdim and not error:
                 nodes, coords = model.mesh.getNodesForPhysicalGroup(d, tag)
-                points[name] = np.asarray(coords, dtype=float).reshape(-1, 3)
+                nodes = np.asarray(nodes, dtype=np.int64)
+                used = in_mesh[nodes]
+                node_ids[name] = np.unique(nodes[used] - 1)  # input node number = gmsh tag − 1
+                if not np.all(used):  # e.g. a gmsh point not embedded in the surface: by position
+                    points[name] = np.asarray(coords, dtype=float).reshape(-1, 3)[~used]
         source = f"gmsh:{model.getCurrent()}"
     else:
         source = None
@@ -232,6 +288,7 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
         raise ValueError(error)
     groups = comm.bcast(groups, root=rank)
     points = comm.bcast(points, root=rank)
+    node_ids = comm.bcast(node_ids, root=rank)
     source = comm.bcast(source, root=rank)
     tdim = comm.bcast(tdim, root=rank)
     top = max(d for d, _ in groups.values())
@@ -245,7 +302,7 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
     ntagged = comm.allreduce(int(np.sum(cell_tags.indices < ncells_local)), op=MPI.SUM)
     if ntagged != ncells:
         raise ValueError(f"{ncells - ntagged} of {ncells} cells have no physical group")
-    return TaggedMesh(msh, cell_tags, groups, points, node_source=source, facet_tags=facet_tags)
+    return TaggedMesh(msh, cell_tags, groups, points, node_ids, node_source=source, facet_tags=facet_tags)
 
 
 def _lower_dimensional_mesh(model, comm: MPI.Comm, rank: int, gdim: int, tdim: int):
@@ -323,18 +380,18 @@ def from_arrays(points: np.ndarray, cells: np.ndarray, cell_name: str = "all",
     cmap = msh.topology.index_map(tdim)
     local = np.arange(cmap.size_local + cmap.num_ghosts, dtype=np.int32)
     tags = dolfinx.mesh.meshtags(msh, tdim, local, np.ones(len(local), dtype=np.int32))
-    pts, ids = {}, {}
+    ids = {}
     for name, idx in point_groups.items():
-        idx = np.asarray(idx, dtype=np.int64)
-        p = np.zeros((len(idx), 3))
-        p[:, :gdim] = points[idx] if comm.rank == 0 else 0.0
-        pts[name] = comm.bcast(p if comm.rank == 0 else None, root=0)
-        ids[name] = comm.bcast(idx if comm.rank == 0 else None, root=0)
+        idx = np.asarray(idx, dtype=np.int64).ravel()
+        bad = comm.rank == 0 and bool(np.any(idx < 0) or np.any(idx >= len(points)))
+        if comm.bcast(bad, root=0):
+            raise ValueError(f"from_arrays: point group '{name}' has node indices outside 0..{len(points) - 1}")
+        ids[name] = comm.bcast(np.unique(idx) if comm.rank == 0 else None, root=0)
     groups = {cell_name: (tdim, 1), **{name: (0, 100 + k) for k, name in enumerate(point_groups)}}
     if node_source is None:
         import uuid
         node_source = comm.bcast(f"arrays:{uuid.uuid4()}" if comm.rank == 0 else None, root=0)
-    return TaggedMesh(msh, tags, groups, pts, ids, node_source=str(node_source))
+    return TaggedMesh(msh, tags, groups, {}, ids, node_source=str(node_source))
 
 
 def box(lengths, n, cell: str = "hexahedron", comm: MPI.Comm = MPI.COMM_WORLD) -> TaggedMesh:

@@ -145,7 +145,7 @@ def run(name: str, h_contact: float, h_foundation: float, steps: int):
     sc.load(body, "load", traction=(0.0, -q))                # F = 100 at λ = 1
     (itf,) = sc.contact(slaves=(body, "arc"), masters=(body, "foundation_top"),
                         law=dc.AugmentedLagrangian(gap_tolerance=1e-4))
-    sc.monitor("top", body, "load")
+    sc.monitor("top", body, "load", reduce="mean")         # the loaded edge's mean displacement
     profiles = {}
 
     def on_step(row):

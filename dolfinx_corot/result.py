@@ -1,4 +1,4 @@
-"""Results: the per-step history of an analysis."""
+"""Results: the per-step history of an analysis and the profiles of monitored groups."""
 from __future__ import annotations
 
 import csv
@@ -51,21 +51,117 @@ class History:
                 w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
 
 
+class Profile:
+    """The dofs of every node of a group, step by step, ordered along the group
+    (``Scene.monitor(..., reduce='profile')``).
+
+    X: (n, gdim) reference coordinates of the nodes, in profile order; s: (n,) their coordinate
+    along the group (``along``: 'arc length', an axis or a direction); dofs: the dof names;
+    steps, load_factors: (steps,) the history's step numbers and load factors; values:
+    (steps, n, len(dofs)). A profile monitored from a restart on only has NaN before it.
+    """
+
+    def __init__(self, name: str, where: str, dofs, X: np.ndarray, s: np.ndarray, along="arc length",
+                 steps=(), load_factors=(), values=None, order: np.ndarray | None = None):
+        self.name, self.where, self.dofs, self.along = name, where, tuple(dofs), along
+        self.X = np.asarray(X, dtype=float)
+        self.s = np.asarray(s, dtype=float)
+        self._order = order  # the group's order → profile order
+        self._steps = [int(k) for k in steps]
+        self._load_factors = [float(v) for v in load_factors]
+        rows = np.zeros((0, len(self.X), len(self.dofs))) if values is None else np.asarray(values, dtype=float)
+        self._rows = list(rows)
+
+    def __repr__(self) -> str:
+        return (f"Profile('{self.name}' on '{self.where}': {len(self.X)} nodes along {self.along}, "
+                f"{len(self._rows)} steps, dofs {self.dofs})")
+
+    def __len__(self) -> int:
+        return len(self._rows)
+
+    @property
+    def steps(self) -> np.ndarray:
+        return np.array(self._steps, dtype=np.int64)
+
+    @property
+    def load_factors(self) -> np.ndarray:
+        return np.array(self._load_factors, dtype=float)
+
+    @property
+    def values(self) -> np.ndarray:
+        """(steps, n, dofs)."""
+        return np.array(self._rows, dtype=float).reshape(len(self._rows), len(self.X), len(self.dofs))
+
+    def append(self, step: int, load_factor: float, values: np.ndarray) -> None:
+        """Add one step: ``values`` (n, dofs) in the group's order (put in profile order here)."""
+        values = np.asarray(values, dtype=float)
+        self._steps.append(int(step))
+        self._load_factors.append(float(load_factor))
+        self._rows.append(values if self._order is None else values[self._order])
+
+    def restore(self, steps, load_factors, values: np.ndarray) -> None:
+        """Replace the steps by those given (``values`` (steps, n, dofs) already in profile order)."""
+        self._steps = [int(k) for k in steps]
+        self._load_factors = [float(v) for v in load_factors]
+        self._rows = list(np.asarray(values, dtype=float).reshape(len(self._steps), len(self.X), len(self.dofs)))
+
+    def column(self, dof: str) -> np.ndarray:
+        """(steps, n) the values of one dof (e.g. 'uy': the settlement trough at every step)."""
+        if dof not in self.dofs:
+            raise KeyError(f"profile '{self.name}' has no dof '{dof}'; its dofs: {list(self.dofs)}")
+        return self.values[:, :, self.dofs.index(dof)]
+
+    def arrays(self, prefix: str = "") -> dict:
+        """The profile as named arrays (for ``.npz`` files); :meth:`from_arrays` reads them back."""
+        meta = json.dumps({"name": self.name, "where": self.where, "dofs": list(self.dofs), "along": self.along})
+        return {f"{prefix}meta": np.array(meta), f"{prefix}X": self.X, f"{prefix}s": self.s,
+                f"{prefix}steps": self.steps, f"{prefix}load_factors": self.load_factors,
+                f"{prefix}values": self.values}
+
+    @classmethod
+    def from_arrays(cls, arrays, prefix: str = "", order: np.ndarray | None = None) -> "Profile":
+        meta = json.loads(str(arrays[f"{prefix}meta"]))
+        return cls(meta["name"], meta["where"], meta["dofs"], arrays[f"{prefix}X"], arrays[f"{prefix}s"],
+                   meta["along"], arrays[f"{prefix}steps"], arrays[f"{prefix}load_factors"],
+                   arrays[f"{prefix}values"], order)
+
+
+def read_profiles(path: str) -> dict[str, Profile]:
+    """The profiles of a ``<name>_profiles.npz`` file written by :meth:`Result.write`."""
+    with np.load(path, allow_pickle=False) as data:
+        names = json.loads(str(data["names"]))
+        return {name: Profile.from_arrays(data, f"profile{i}_") for i, name in enumerate(names)}
+
+
 @dataclass
 class Result:
-    """History plus totals of one analysis."""
+    """History, profiles and totals of one analysis.
+
+    profiles: name → :class:`Profile` of the scene's profile monitors."""
 
     history: History
     completed: bool = True
     message: str = ""
     totals: dict = field(default_factory=dict)
+    profiles: dict = field(default_factory=dict)
 
     def write(self, directory: str, name: str = "history") -> str:
-        """Write ``<directory>/<name>.csv`` and a JSON summary; returns the CSV path."""
+        """Write ``<directory>/<name>.csv``, a JSON summary and, with profiles,
+        ``<name>_profiles.npz`` (read it with :func:`read_profiles`); returns the CSV path."""
         path = os.path.join(directory, f"{name}.csv")
         self.history.to_csv(path)
+        summary = {"completed": self.completed, "message": self.message, **self.totals}
+        if self.profiles:
+            summary["profiles"] = {p.name: {"where": p.where, "dofs": list(p.dofs), "nodes": len(p.X),
+                                            "along": p.along, "file": f"{name}_profiles.npz"}
+                                   for p in self.profiles.values()}
+            arrays = {"names": np.array(json.dumps(list(self.profiles)))}
+            for i, p in enumerate(self.profiles.values()):
+                arrays.update(p.arrays(f"profile{i}_"))
+            with open(os.path.join(directory, f"{name}_profiles.npz"), "wb") as f:
+                np.savez(f, **arrays)
         with open(os.path.join(directory, f"{name}_summary.json"), "w") as f:
-            json.dump({"completed": self.completed, "message": self.message, **self.totals}, f, indent=1)
+            json.dump(summary, f, indent=1)
         return path
 
 

@@ -27,17 +27,36 @@ from .io.mesh import TaggedMesh
 from .materials import Elastic
 from .parts import Coupled, Part, PartRef, part_for_mesh
 from .parts.base import finite_vector
+from .parts.groups import chain_coordinate
+from .result import Profile
 from .sections import Section
 
 KINEMATICS = ("bernoulli", "timoshenko")
 
 
+REDUCTIONS = {
+    "sum": lambda v: np.sum(v, axis=0),
+    "mean": lambda v: np.mean(v, axis=0),
+    "max": lambda v: np.max(v, axis=0),
+    "min": lambda v: np.min(v, axis=0),
+    "absmax": lambda v: v[np.argmax(np.abs(v), axis=0), np.arange(v.shape[1])],
+}
+"""Reductions of a group's nodal values (n, ndof) to one value per dof; ``absmax`` is the value of
+largest magnitude, with its sign."""
+
+
 @dataclass(frozen=True)
 class Monitor:
+    """What a monitor records: the dofs of group ``where`` (``kind`` 'dofs': one node, a reduction
+    ``reduce`` over the nodes, or a profile of all of them ordered ``along`` the group) or the
+    reaction there (``kind`` 'reaction')."""
+
     name: str
     part: PartRef
     where: str
     kind: str = "dofs"  # or "reaction"
+    reduce: str | None = None
+    along: object = None
 
 
 class Scene:
@@ -60,6 +79,7 @@ class Scene:
         self._models: dict[int, Part] = {}
         self._coupled: Coupled | None = None
         self.monitors: list[Monitor] = []
+        self._groups: dict = {}
         self._loads = 0
         self._prescribed = 0
         self.interfaces: list = []
@@ -237,12 +257,48 @@ class Scene:
         self.interfaces += made
         return made
 
-    def monitor(self, name: str, part: PartRef, where: str) -> None:
-        """Record the dofs of the (first) node of group ``where`` after every step, as
-        ``name_ux``, ``name_uy``, … In 2D ``name_rz`` is the total angle (it may exceed 2π);
-        in 3D ``name_rx..rz`` is the rotation vector of the nodal rotation (norm ≤ π)."""
-        part.model.nodal_values(where)  # fails early for a missing group
-        self._add_monitor(Monitor(name, part, where))
+    def monitor(self, name: str, part: PartRef, where: str, reduce: str | None = None, along=None) -> None:
+        """Record the dofs of the nodes of group ``where`` after every step.
+
+        reduce=None: the group has one node (a point); its dofs become the history columns
+        ``name_ux``, ``name_uy``, … (``name_rz`` in 2D is the total angle, which may exceed 2π; in
+        3D ``name_rx..rz`` is the rotation vector of the nodal rotation, norm ≤ π). A group of
+        several nodes is refused: say which value of it to record.
+
+        reduce='sum', 'mean', 'max', 'min' or 'absmax': one value per dof over the group's nodes,
+        columns ``name_ux_mean``, ``name_uy_mean``, … (each dof reduced on its own: the largest
+        ux and the largest uy may be at different nodes; 'absmax' is the value of largest
+        magnitude, with its sign; rotations are reduced component by component).
+
+        reduce='profile': every node of the group, ordered along it, kept in
+        ``result.profiles[name]`` (a :class:`dolfinx_corot.result.Profile`: the nodes' reference
+        coordinates ``X``, their coordinate ``s`` along the group and the values per step,
+        ``values`` (steps, nodes, dofs)) rather than in history columns; a settlement trough, a
+        deflection line. along=None orders the nodes by the arc length along the chain of the
+        group's lines (a beam, a boundary line of a 2D solid, an edge of a shell), from its end of
+        smallest (x, y, z) (a closed ring in 2D: counter-clockwise from its node of smallest
+        (x, y)); along='x', 'y', 'z' or a direction (gdim numbers): by that coordinate. A profile
+        monitor added at a restart has NaN values for the steps before it.
+
+        The nodes of a group are those its supports and loads act on (a facet group of a
+        quadratic solid includes the mid-side nodes); each node counts once under MPI, and the
+        values are the same on every rank and equal to the serial ones.
+        """
+        label = f"monitor '{name}'"
+        if reduce is not None and reduce != "profile" and reduce not in REDUCTIONS:
+            raise ValueError(f"{label}: reduce = {reduce!r} is not one of None, {', '.join(map(repr, REDUCTIONS))} "
+                             "or 'profile'")
+        if along is not None and reduce != "profile":
+            raise ValueError(f"{label}: along orders the nodes of a profile; give reduce='profile' with it")
+        group = part.model.node_group(where)  # fails early for a missing or empty group
+        if reduce is None and len(group) > 1:
+            raise ValueError(f"{label}: group '{where}' has {len(group)} nodes; say which value to record: "
+                             f"reduce={', '.join(map(repr, REDUCTIONS))} (columns {name}_ux_mean, …) or 'profile' "
+                             f"(every node, in result.profiles['{name}']), or monitor a group of one node")
+        if reduce == "profile":
+            chain_coordinate(group, along, f"{label} on group '{where}'")  # fails early for a group with no order
+        self._add_monitor(Monitor(name, part, where, "dofs", reduce, along))
+        self._groups[(name, "dofs")] = group
 
     def _add_monitor(self, monitor: Monitor) -> None:
         taken = [m for m in self.monitors if m.name == monitor.name and m.kind == monitor.kind]
@@ -297,7 +353,8 @@ class Scene:
                 "interfaces": [itf.describe() for itf in self.interfaces]}
 
     def monitor_values(self, system) -> dict[str, float]:
-        """Monitored dofs and reactions at the current state (``system`` holds f_int)."""
+        """Monitored dofs (one node, or a reduction over a group) and reactions at the current state
+        (``system`` holds f_int), by history column."""
         values = {}
         for mon in self.monitors:
             model = mon.part.model
@@ -308,7 +365,40 @@ class Scene:
                 names = ("Fx", "Fy", "Mz") if model.gdim == 2 else ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
                 for comp, val in zip(names, fext - fint):
                     values[f"{mon.name}_{comp}"] = -float(val)
-            else:
-                for comp, val in zip(model.dof_names, model.nodal_values(mon.where)):
-                    values[f"{mon.name}_{comp}"] = float(val)
+            elif mon.reduce != "profile":
+                nodal = self._group(mon).values(model)
+                reduced = nodal[0] if mon.reduce is None else REDUCTIONS[mon.reduce](nodal)
+                suffix = "" if mon.reduce is None else f"_{mon.reduce}"
+                for comp, val in zip(model.dof_names, reduced):
+                    values[f"{mon.name}_{comp}{suffix}"] = float(val)
         return values
+
+    def _group(self, mon: Monitor):
+        """The node group of a monitor (found once: a group's nodes do not change)."""
+        key = (mon.name, mon.kind)
+        if key not in self._groups:
+            self._groups[key] = mon.part.model.node_group(mon.where)
+        return self._groups[key]
+
+    def profiles(self) -> dict:
+        """Empty :class:`~dolfinx_corot.result.Profile` of every profile monitor, its nodes ordered
+        along the group in the current reference configuration (at the start of a run)."""
+        out = {}
+        for mon in self.monitors:
+            if mon.reduce == "profile":
+                model = mon.part.model
+                group = model.node_group(mon.where)
+                self._groups[(mon.name, mon.kind)] = group
+                s = chain_coordinate(group, mon.along, f"monitor '{mon.name}' on group '{mon.where}'")
+                order = np.lexsort((np.arange(len(s)), s))
+                along = "arc length" if mon.along is None else \
+                    (mon.along if isinstance(mon.along, str) else [float(c) for c in np.ravel(mon.along)])
+                out[mon.name] = Profile(mon.name, mon.where, tuple(model.dof_names), group.X[order], s[order], along,
+                                        order=order)
+        return out
+
+    def profile_values(self) -> dict[str, np.ndarray]:
+        """(nodes, dofs) values of every profile monitor at the current state, in the group's order
+        (a :class:`~dolfinx_corot.result.Profile` puts them in its own)."""
+        return {mon.name: self._group(mon).values(mon.part.model) for mon in self.monitors
+                if mon.reduce == "profile"}

@@ -23,6 +23,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from ..io.mesh import TaggedMesh
+from .groups import NodeGroup, gather_group
 from .surface import Surface, SurfaceError
 
 
@@ -278,17 +279,47 @@ class Part:
         local = values.reshape(-1, self.ndof)[blocks].sum(axis=0) if len(blocks) else np.zeros(self.ndof)
         return global_sum(self.comm, np.asarray(local, dtype=float))
 
-    def nodal_values(self, where: str) -> np.ndarray:
-        """Values of the dofs of the first node of group ``where``, identical on every rank."""
-        blocks = owned_dofs_of_vertices(self.V, self.tmesh.vertices(where))
-        local = np.zeros(self.ndof + 1)
-        if len(blocks):
-            local[: self.ndof] = self._dof_values(self.state.x.array.reshape(-1, self.state_size)[blocks[0]])
-            local[self.ndof] = 1.0
-        for v in self.comm.allgather(local):
-            if v[self.ndof] == 1.0:
-                return v[: self.ndof].copy()
-        raise ValueError(f"group '{where}' has no node")
+    def dof_values(self, blocks: np.ndarray) -> np.ndarray:
+        """(len(blocks), ndof) dof values (displacements, rotations as monitored) of local blocks."""
+        st = self.state.x.array.reshape(-1, self.state_size)[np.asarray(blocks, dtype=np.int32)]
+        return np.array([self._dof_values(s) for s in st], dtype=float).reshape(len(st), self.ndof)
+
+    def node_group(self, where: str) -> NodeGroup:
+        """The nodes of group ``where`` (those its supports and loads act on), gathered on every rank
+        in a partition-independent order, with the lines of the group (a chain for profiles)."""
+        group = gather_group(self, where, self.owned_blocks(where), self._group_lines(where))
+        if len(group) == 0:
+            raise ValueError(f"group '{where}' has no node")
+        return group
+
+    def _group_lines(self, where: str) -> np.ndarray | None:
+        """(m, 2) local blocks of the end nodes of the group's lines that this rank adds (the owned
+        cells of a group of lines of a mesh of lines; the owned facets of a group of facets that
+        are lines), or None: the group is not made of lines."""
+        mesh = self.tmesh.mesh
+        dim = self.tmesh.groups[where][0]
+        if dim != 1 or self.tdim not in (1, 2):
+            return None
+        if self.tdim == 1:
+            entities = self.tmesh.cells(where)
+        else:
+            entities = self.tmesh.facets(where)
+            if entities is None:
+                return None
+        entities = entities[entities < mesh.topology.index_map(1).size_local]
+        tdim = self.tdim
+        mesh.topology.create_connectivity(1, 0)
+        mesh.topology.create_connectivity(tdim, 0)
+        c2v = mesh.topology.connectivity(tdim, 0)
+        ncells = len(c2v.offsets) - 1
+        nv = len(c2v.array) // max(ncells, 1)
+        vertex_block = np.full(mesh.topology.index_map(0).size_local + mesh.topology.index_map(0).num_ghosts, -1,
+                               dtype=np.int64)
+        if ncells:  # the first dofs of a Lagrange cell are at its vertices, in the cell's vertex order
+            vertex_block[c2v.array] = self.V.dofmap.list.array.reshape(ncells, -1)[:, :nv].ravel()
+        f2v = mesh.topology.connectivity(1, 0)
+        ends = np.array([f2v.links(e) for e in entities], dtype=np.int64).reshape(-1, 2)
+        return vertex_block[ends]
 
     def nodes(self) -> tuple[np.ndarray, np.ndarray]:
         """(X (n, gdim) initial positions, state (n, state_size)) of all nodes, on every rank."""

@@ -2,7 +2,8 @@
 
 Checkpoint files (``.npz``) hold the configuration of every part and the
 state of every contribution (contact multipliers, candidate pairs) as
-partition-independent arrays, the history, the driver's position and a
+partition-independent arrays, the history and the monitored profiles, the
+driver's position and a
 *fingerprint* of the scene: a SHA-256 of its description (mesh sizes, a hash
 of the node coordinates, groups, elements and materials of every part, the
 contact interfaces). A restart refuses a file written for another scene
@@ -21,7 +22,7 @@ import zlib
 import numpy as np
 
 from ..assembly import System, make_system
-from ..result import History, Result
+from ..result import History, Profile, Result
 from .newton import ConvergenceError, NewtonReport
 
 logger = logging.getLogger(__name__)
@@ -86,6 +87,7 @@ class Run:
         self.on_step = on_step
         self.checkpoint_path = checkpoint
         self.history = History()
+        self.profiles: dict[str, Profile] = scene.profiles()
         self.t_start = time.perf_counter()
         self.cuts = 0
         self.iterations = 0
@@ -128,6 +130,8 @@ class Run:
         row.update(extra or {})
         row.update(self.scene.monitor_values(self.system))
         self.history.append(row)
+        for name, values in self.scene.profile_values().items():
+            self.profiles[name].append(self.step, lam, values)
         logger.info("step %d: lambda = %.6g, %d iterations, |r|: %s", self.step, lam, report.iterations,
                     row["residuals"])
         if self.on_step is not None:
@@ -148,7 +152,9 @@ class Run:
             meta = {"format": FORMAT, "fingerprint": self.fingerprint, "scene": self._description,
                     "large_rotations": self.scene.large_rotations, "step": self.step,
                     "load_factor": self.load_factor, "cuts": self.cuts, "iterations": self.iterations,
-                    "history": self.history.rows, "driver": driver_state}
+                    "history": self.history.rows, "driver": driver_state, "profiles": list(self.profiles)}
+            for i, profile in enumerate(self.profiles.values()):
+                arrays.update(profile.arrays(f"profile{i}_"))
             tmp = self.checkpoint_path + ".tmp"
             with open(tmp, "wb") as f:
                 np.savez(f, meta=np.array(json.dumps(meta, default=str)), **arrays)
@@ -188,17 +194,34 @@ class Run:
         self.cuts, self.iterations = meta["cuts"], meta["iterations"]
         for row in meta["history"]:
             self.history.append(row)
+        self._restore_profiles(path, meta.get("profiles", []), arrays)
         return meta["driver"], arrays
+
+    def _restore_profiles(self, path: str, saved: list, arrays: dict) -> None:
+        """The profiles' steps up to the checkpoint; a profile the checkpoint does not hold (a monitor
+        added at the restart) has NaN values for them."""
+        rows = self.history.rows
+        for name, profile in self.profiles.items():
+            if name in saved:
+                old = Profile.from_arrays(arrays, f"profile{saved.index(name)}_")
+                if old.X.shape != profile.X.shape or not np.array_equal(old.X, profile.X):
+                    raise CheckpointError(f"checkpoint {path}: profile '{name}' was recorded on other nodes "
+                                          f"({len(old.X)}) than the monitor of that name now ({len(profile.X)}, "
+                                          f"group '{profile.where}')")
+                profile.restore(old.steps, old.load_factors, old.values)
+            else:
+                nan = np.full((len(rows), len(profile.X), len(profile.dofs)), np.nan)
+                profile.restore([r["step"] for r in rows], [r["load_factor"] for r in rows], nan)
 
     def totals(self) -> dict:
         return {"steps": len(self.history), "newton_iterations": self.iterations, "cuts": self.cuts,
                 "wall_time": time.perf_counter() - self.t_start}
 
     def fail(self, msg: str):
-        raise ConvergenceError(msg, Result(self.history, False, msg, self.totals()))
+        raise ConvergenceError(msg, Result(self.history, False, msg, self.totals(), self.profiles))
 
     def result(self, message: str = "") -> Result:
-        return Result(self.history, True, message, self.totals())
+        return Result(self.history, True, message, self.totals(), self.profiles)
 
 
 def solve(scene, driver, system: System | None = None, on_step=None, checkpoint: str | None = None,

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 
@@ -9,17 +10,28 @@ from dataclasses import dataclass
 class Elastic:
     """Isotropic linear elastic material.
 
-    E: Young's modulus (> 0); nu: Poisson's ratio in (-1, 0.5).
+    E: Young's modulus (> 0); nu: Poisson's ratio in (-1, 0.5); density: mass per unit
+    volume ρ (≥ 0), or None. ``scene.gravity`` takes ρ from here when it is not given
+    a density: ρ·g per unit volume of a solid, ρ·A·g per unit length of a beam or bar,
+    ρ·t·g per unit area of a shell or membrane.
     """
 
     E: float
     nu: float = 0.0
+    density: float | None = None
 
     def __post_init__(self):
+        name = type(self).__name__
         if not (math.isfinite(self.E) and self.E > 0.0):
-            raise ValueError(f"Elastic: Young's modulus E = {self.E} must be positive and finite")
+            raise ValueError(f"{name}: Young's modulus E = {self.E} must be positive and finite")
         if not (-1.0 < self.nu < 0.5):
-            raise ValueError(f"Elastic: Poisson's ratio nu = {self.nu} must lie in (-1, 0.5)")
+            raise ValueError(f"{name}: Poisson's ratio nu = {self.nu} must lie in (-1, 0.5)")
+        if self.density is not None:
+            ok = isinstance(self.density, numbers.Real) and not isinstance(self.density, bool) \
+                and math.isfinite(self.density) and self.density >= 0.0
+            if not ok:
+                raise ValueError(f"{name}(E={self.E}, nu={self.nu}): density = {self.density!r} must be a finite "
+                                 "number ≥ 0 (or None: no self-weight from the material)")
 
     @property
     def G(self) -> float:

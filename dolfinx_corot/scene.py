@@ -17,6 +17,7 @@ Example::
 """
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -119,7 +120,8 @@ class Scene:
         return self._model(tmesh, solid_degree=int(degree)).add_region(where, material)
 
     def add_beam(self, tmesh: TaggedMesh, where: str | None = None, *, section: Section,
-                 material: Elastic, kinematics: str = "bernoulli", orientation=(0.0, 0.0, 1.0)) -> PartRef:
+                 material: Elastic, kinematics: str = "bernoulli", orientation=(0.0, 0.0, 1.0),
+                 plane_strain: bool = False) -> PartRef:
         """Beam elements on the cells of group ``where`` (all cells if None).
 
         kinematics: 'bernoulli' (no shear deformation) or 'timoshenko' (shear
@@ -127,6 +129,10 @@ class Scene:
         ``orientation`` is a vector whose part normal to each element is the
         local y axis (``section.Iz`` is about the local z axis, ``section.Iy``
         about y); it is ignored in 2D.
+        plane_strain (2D only): the beam stands for a plate strip of unit width in plane
+        strain (a tunnel lining): axial and bending stiffness take the plate modulus
+        E/(1 − ν²) (section per unit width, e.g. ``dc.Rectangle(1.0, t)``); the shear
+        modulus stays G.
         """
         if kinematics not in KINEMATICS:
             raise ValueError(f"kinematics '{kinematics}' is not one of {KINEMATICS}")
@@ -134,7 +140,12 @@ class Scene:
         model = self._model(tmesh)
         if kinematics == "timoshenko" and section.As <= 0.0:
             raise ValueError(f"beam '{where}': Timoshenko kinematics needs a shear area As > 0")
-        return model.add_beam(where, section, material, kinematics, orientation)
+        if plane_strain and model.gdim != 2:
+            raise ValueError(f"beam '{where}': plane_strain is for 2D beams (a plate strip of unit width); "
+                             f"this mesh is in {model.gdim}D, where a beam has a section of its own")
+        ref = model.add_beam(where, section, material, kinematics, orientation, plane_strain=bool(plane_strain))
+        model.set_mass(ref, material.density, section.A)
+        return ref
 
     def add_shell(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float, material: Elastic,
                   membrane: str = "opt", drilling: float = 1e-2) -> PartRef:
@@ -146,8 +157,10 @@ class Scene:
         ``"cst"``, the constant-strain triangle with a drilling penalty α·G·t·A, α = ``drilling``.
         """
         self._check_material("shell", where, material)
-        return self._model(tmesh).add_shell(where, material.E, material.nu, float(thickness), float(drilling),
-                                            membrane)
+        model = self._model(tmesh)
+        ref = model.add_shell(where, material.E, material.nu, float(thickness), float(drilling), membrane)
+        model.set_mass(ref, material.density, float(thickness))
+        return ref
 
     def add_membrane(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float,
                      material: Elastic) -> PartRef:
@@ -155,7 +168,10 @@ class Scene:
         (constant-strain triangles) or quadrilateral (bilinear Q4) mesh in space; nodes
         carried by membranes alone have their rotations fixed."""
         self._check_material("membrane", where, material)
-        return self._model(tmesh).add_membrane(where, material.E, material.nu, float(thickness))
+        model = self._model(tmesh)
+        ref = model.add_membrane(where, material.E, material.nu, float(thickness))
+        model.set_mass(ref, material.density, float(thickness))
+        return ref
 
     def add_truss(self, tmesh: TaggedMesh, where: str | None = None, *, area: float, material: Elastic,
                   prestress_force: float = 0.0) -> PartRef:
@@ -166,7 +182,10 @@ class Scene:
         self._check_material("truss", where, material)
         if not area > 0.0:
             raise ValueError(f"truss '{where}': area = {area} must be positive")
-        return self._model(tmesh).add_truss(where, area, material, prestress_force)
+        model = self._model(tmesh)
+        ref = model.add_truss(where, area, material, prestress_force)
+        model.set_mass(ref, material.density, float(area))
+        return ref
 
     @staticmethod
     def _check_material(kind: str, where, material) -> None:
@@ -228,14 +247,33 @@ class Scene:
             model.add_load(where, values, amplitude)
             self._loads += 1
 
-    def gravity(self, part: PartRef, acceleration, density: float, where: str | None = None,
+    def gravity(self, part: PartRef, acceleration, density: float | None = None, where: str | None = None,
                 amplitude=None) -> None:
-        """Body force ρ·g per unit reference volume on a solid (cells of ``where``, all if None)."""
+        """Self-weight under the gravitational acceleration g (gdim numbers), a dead load scaled by
+        the load factor λ (or by ``amplitude(λ)``) like the other loads.
+
+        density: mass per unit volume ρ; None: the density of the part's material
+        (``dc.Elastic(E, nu, density=ρ)``).
+
+        * Solids: body force ρ·g per unit reference volume on the cells of ``where`` (all
+          cells of the mesh if None); with density None each cell's material gives ρ.
+        * Beams and bars: ρ·A·g per unit reference length; shells and membranes: ρ·t·g per
+          unit reference area; on the elements of ``part`` (those in group ``where`` if
+          given), as work-equivalent nodal loads computed from the reference geometry
+          (:mod:`dolfinx_corot.elements.uniform_load`: the weight of each element shared
+          by its nodes, and the fixed-end moments ±q l²/12 of beams, kept at their
+          reference values under large rotation).
+        """
         model = part.model
-        acc = np.atleast_1d(np.asarray(acceleration, dtype=float))
-        if acc.shape != (model.gdim,) or not (np.isfinite(density) and density >= 0.0):
-            raise ValueError(f"gravity: acceleration must be {model.gdim} numbers and density ≥ 0")
-        model.add_body_force(where, density * acc, amplitude)
+        label = f"gravity on {part.kind} '{part.name or 'all cells'}'"
+        acc = finite_vector(label, "acceleration", acceleration, model.gdim)
+        if density is not None:
+            ok = isinstance(density, numbers.Real) and not isinstance(density, bool) and np.isfinite(density) \
+                and density >= 0.0
+            if not ok:
+                raise ValueError(f"{label}: density = {density!r} must be a finite number ≥ 0")
+            density = float(density)
+        model.add_gravity(part, acc, density, where, amplitude)
         self._loads += 1
 
     def contact(self, slaves: tuple[PartRef, str], masters: tuple[PartRef, str], law=None,

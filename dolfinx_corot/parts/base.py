@@ -118,6 +118,7 @@ class Part:
         self._prescribed: list[tuple[tuple[int, np.ndarray], int, Motion]] = []
         self._prescribed_values: list[tuple[dolfinx.fem.Function, np.ndarray, Motion]] = []
         self._point_loads: list[tuple[np.ndarray, np.ndarray, object]] = []
+        self._mass: dict[tuple[str, str], tuple[float | None, float]] = {}
         self.lifting_bcs: list = []
         self._forms = None
         self.stage: int | None = None
@@ -405,7 +406,7 @@ class Part:
         cell = self.tmesh.mesh.topology.cell_name()
         raise ValueError(f"{kind} '{where}': {need}; this mesh has {cell}s in {self.gdim}D{hint}")
 
-    def add_beam(self, where, section, material, kinematics, orientation) -> PartRef:
+    def add_beam(self, where, section, material, kinematics, orientation, plane_strain=False) -> PartRef:
         self._refuse_kind("beam", where, "beams need a mesh of lines", " (for beams on shells read the lines "
                           "as a mesh of their own: from_gmsh(model, 3, dim=1))")
 
@@ -422,8 +423,17 @@ class Part:
     def add_traction(self, where: str, traction: np.ndarray, amplitude=None) -> None:
         raise ValueError(f"load '{where}': tractions act on solids; structures take forces and moments")
 
-    def add_body_force(self, where, force: np.ndarray, amplitude=None) -> None:
-        raise ValueError("gravity acts on solids (structural self-weight: point loads)")
+    def set_mass(self, part: PartRef, density: float | None, measure: float) -> None:
+        """The density ρ of the material of ``part`` (None: not given) and the measure of its
+        cross-section that makes ρ a mass per element size: the area A of beams and bars (mass
+        per unit length), the thickness t of shells and membranes (mass per unit area)."""
+        self._mass[(part.kind, part.name)] = (density, float(measure))
+
+    def add_gravity(self, part: PartRef, acceleration: np.ndarray, density: float | None, where: str | None,
+                    amplitude=None) -> None:
+        """Self-weight of ``part`` under the gravitational acceleration g (gdim,), dead and scaled
+        like the other loads; ``density`` None: the material's."""
+        raise NotImplementedError(f"gravity on {part.kind} '{part.name}': not available for {self.kind_name} parts")
 
     def load_values(self, where: str, force, moment) -> np.ndarray:
         """The nodal load vector of a force and a moment (checked), in the part's dof order."""

@@ -24,6 +24,7 @@ import dolfinx.la
 from .. import _dolfinx, rotations
 from ..elements import beam3d as law3d
 from ..elements import line2d as law2d
+from ..elements import uniform_load
 from ..io.mesh import TaggedMesh
 from ..kernels import beam3d as kernels3d
 from ..kernels import line2d as kernels2d
@@ -57,6 +58,7 @@ class LineFrame(Part):
         self._owner_of_cell = np.full(cmap.size_local + cmap.num_ghosts, "", dtype=object)
         self._bending = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
         self._element_props: list[tuple[str, list[float]]] = []
+        self._gravity: list[tuple[str, str | None, np.ndarray, object]] = []
         self._init_conditions()
 
     # -- building -----------------------------------------------------------
@@ -139,6 +141,67 @@ class LineFrame(Part):
     def add_truss(self, where, area, material, prestress_force) -> PartRef:
         return self.add_bars(where, material.E * area, float(prestress_force))
 
+    # -- self-weight --------------------------------------------------------------
+    @staticmethod
+    def _label(part: PartRef) -> str:
+        return f"{part.kind} '{part.name or 'all cells'}'"
+
+    def _weight_cells(self, label: str, where: str | None) -> np.ndarray:
+        """Owned cells of the elements ``label``, within group ``where`` if given."""
+        n_owned = self.tmesh.mesh.topology.index_map(self.tdim).size_local
+        cells = np.flatnonzero(self._owner_of_cell[:n_owned] == label).astype(np.int32)
+        if where is not None:
+            cells = np.intersect1d(cells, self.tmesh.cells(where))
+        return cells
+
+    def add_gravity(self, part: PartRef, acceleration: np.ndarray, density: float | None, where: str | None,
+                    amplitude=None) -> None:
+        """Self-weight ρ·A·g per unit reference length of beams and bars, ρ·t·g per unit reference
+        area of shells and membranes, of the elements of ``part`` (within group ``where`` if given),
+        as dead work-equivalent nodal loads (:mod:`dolfinx_corot.elements.uniform_load`)."""
+        label = self._label(part)
+        stored, measure = self._mass.get((part.kind, part.name), (None, None))
+        density = stored if density is None else density
+        if density is None:
+            raise ValueError(f"gravity on {label}: its material has no density; give it one "
+                             "(dc.Elastic(E, nu, density=ρ)) or pass density= to scene.gravity")
+        if measure is None:
+            raise ValueError(f"gravity on {label}: its cross-section is unknown (add it with Scene.add_*)")
+        if where is not None and not self.comm.allreduce(len(self._weight_cells(label, where))):
+            raise ValueError(f"gravity on {label}: group '{where}' holds none of its elements")
+        q = float(density) * measure * np.asarray(acceleration, dtype=float)
+        self._gravity.append((label, where, q, amplitude))
+
+    def _load_amplitudes(self) -> list:
+        return [amp for *_, amp in self._point_loads + self._gravity]
+
+    def _add_distributed_loads(self, b: PETSc.Vec, amplitude) -> None:
+        """Add the self-weight loads of one amplitude (None: proportional to λ) at unit factor,
+        from the reference positions of the nodes."""
+        terms = [(label, where, q) for label, where, q, amp in self._gravity if amp is amplitude]
+        if not terms:
+            return
+        g = self.gdim
+        loads = dolfinx.fem.Function(self.V)
+        arr = loads.x.array.reshape(-1, self.ndof)
+        cell_blocks = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)
+        for label, where, q in terms:
+            cells = self._weight_cells(label, where)
+            blocks = cell_blocks[cells]
+            X = self.reference[blocks]
+            if self.tdim == 1:
+                forces, moments = uniform_load.line_loads(X, q, self._bending[cells])
+                np.add.at(arr[:, g:], blocks, moments.reshape(len(cells), 2, self.ndof - g))
+            elif self.nodes_per_cell == 3:
+                forces = uniform_load.triangle_loads(X, q)
+            else:
+                forces = uniform_load.quad_loads(X, q)
+            np.add.at(arr[:, :g], blocks, forces)
+        loads.x.scatter_reverse(dolfinx.la.ScatterMode.add)
+        n = self.V.dofmap.index_map.size_local * self.ndof
+        with b.localForm() as bl:
+            bl.array[:n] += loads.x.array[:n]
+
     # -- Model protocol (assembly.System) ------------------------------------
     def forms(self):
         if self._forms is None:
@@ -205,9 +268,12 @@ class Frame2D(AdditiveState, LineFrame):
         super().__init__(tmesh, large_rotations)
         self.state = dolfinx.fem.Function(self.V, name="state")  # state and corrections share V
 
-    def add_beam(self, where, section, material, kinematics, orientation) -> PartRef:
+    def add_beam(self, where, section, material, kinematics, orientation, plane_strain=False) -> PartRef:
+        """plane_strain: the beam is a plate strip of unit width bending in plane strain; axial
+        and bending stiffness take the plate modulus E/(1 − ν²), the shear stiffness G·As."""
+        E = material.E / (1.0 - material.nu**2) if plane_strain else material.E
         GAs = material.G * section.As if kinematics == "timoshenko" else 0.0
-        return self._add(where, material.E * section.A, material.E * section.I, GAs, 0.0, "beam")
+        return self._add(where, E * section.A, E * section.I, GAs, 0.0, "beam")
 
     def add_bars(self, where, EA: float, N0: float) -> PartRef:
         return self._add(where, EA, 0.0, 0.0, N0, "truss")
@@ -301,7 +367,10 @@ class Frame3D(Rotations3D, LineFrame):
         LineFrame.__init__(self, tmesh, large_rotations)
         self._init_state()
 
-    def add_beam(self, where, section, material, kinematics, orientation) -> PartRef:
+    def add_beam(self, where, section, material, kinematics, orientation, plane_strain=False) -> PartRef:
+        if plane_strain:
+            raise ValueError(f"beam '{where}': plane_strain is for 2D beams (a plate strip of unit width); "
+                             "a beam in 3D has its own section")
         GAs = material.G * section.As if kinematics == "timoshenko" else 0.0
         return self._add(where, {"EA": material.E * section.A, "GJ": material.G * section.torsion_constant,
                                  "EIy": material.E * section.second_moment_y, "EIz": material.E * section.I,

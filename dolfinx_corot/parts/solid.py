@@ -76,13 +76,15 @@ class Solid(AdditiveState, Part):
         Q = dolfinx.fem.FunctionSpace(mesh, ("DG", 0))
         self.E = dolfinx.fem.Function(Q, name="E")
         self.nu = dolfinx.fem.Function(Q, name="nu")
+        self.density = dolfinx.fem.Function(Q, name="density")  # of the materials (0 where not given)
         self._cell_dof = Q.dofmap.list.array
         cmap = mesh.topology.index_map(self.tdim)
         self._owner_of_cell = np.full(cmap.size_local + cmap.num_ghosts, "", dtype=object)
+        self._has_density = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
         self.law: type | None = None
         self._regions: list[tuple[str, str, float, float]] = []
         self._tractions: list[tuple[str, np.ndarray, object]] = []
-        self._body: list[tuple[str | None, np.ndarray, object]] = []
+        self._body: list[tuple[str | None, np.ndarray, bool, object]] = []  # (where, b, × material ρ, amplitude)
         self._init_conditions()
         self._shifted = False
 
@@ -102,6 +104,8 @@ class Solid(AdditiveState, Part):
         self._owner_of_cell[cells] = label
         self.E.x.array[self._cell_dof[cells]] = material.E
         self.nu.x.array[self._cell_dof[cells]] = material.nu
+        self.density.x.array[self._cell_dof[cells]] = material.density or 0.0
+        self._has_density[cells] = material.density is not None
         self.law = kind
         ref = PartRef(self, where or "", "solid")
         self.parts.append(ref)
@@ -138,10 +142,34 @@ class Solid(AdditiveState, Part):
                              "from_gmsh is needed")
         self._tractions.append((where, np.asarray(traction, dtype=float), amplitude))
 
-    def add_body_force(self, where: str | None, force: np.ndarray, amplitude=None) -> None:
+    def add_body_force(self, where: str | None, force: np.ndarray, amplitude=None,
+                       material_density: bool = False) -> None:
+        """Body force per unit reference volume on the cells of ``where`` (all if None): ``force``,
+        or ρ·``force`` with the density ρ of each cell's material (``material_density``)."""
         if where is not None:
             self.tmesh.cells(where)  # fails early for a missing group
-        self._body.append((where, np.asarray(force, dtype=float), amplitude))
+        self._body.append((where, np.asarray(force, dtype=float), bool(material_density), amplitude))
+        if material_density:
+            self._check_density(where)
+
+    def add_gravity(self, part: PartRef, acceleration: np.ndarray, density: float | None, where: str | None,
+                    amplitude=None) -> None:
+        """Body force ρ·g per unit reference volume on the cells of ``where`` (all cells of the
+        mesh if None, whatever region ``part`` names); ``density`` None: each cell's material's."""
+        self.add_body_force(where, acceleration if density is None else density * acceleration, amplitude,
+                            material_density=density is None)
+
+    def _check_density(self, where: str | None) -> None:
+        """Every cell of ``where`` (all if None) has a material with a density (checked on all ranks)."""
+        cells = self.tmesh.cells(where)
+        cells = cells[cells < self.tmesh.mesh.topology.index_map(self.tdim).size_local]
+        bad = cells[~self._has_density[cells]]
+        found = self.comm.allgather(str(self._owner_of_cell[bad[0]]) if len(bad) else None)
+        if any(f is not None for f in found):
+            label = next(f for f in found if f is not None)
+            raise ValueError(f"gravity on '{where or 'all cells'}' of the solid: {label or 'a cell without material'}"
+                             " has no density; give its material one (dc.SaintVenantKirchhoff(E, nu, density=ρ)) "
+                             "or pass density= to scene.gravity")
 
     def _load_amplitudes(self) -> list:
         return [amp for *_, amp in self._tractions + self._body + self._point_loads]
@@ -230,10 +258,13 @@ class Solid(AdditiveState, Part):
                     term = ufl.inner(ufl.as_vector([float(c) for c in t]), v)
                     terms.append((term if area is None else area * term) * ds(tag))
         dx = ufl.Measure("dx", domain=self.V.mesh, subdomain_data=self.tmesh.cell_tags)
-        for where, b, amp in self._body:
+        for where, b, material_density, amp in self._body:
             if amp is amplitude:
                 measure = dx if where is None else dx(self.tmesh.groups[where][1])
                 term = ufl.inner(ufl.as_vector([float(c) for c in b]), v)
+                if material_density:
+                    self._check_density(where)  # a region given later may have none
+                    term = self.density * term
                 terms.append((term if volume is None else volume * term) * measure)
         if not terms:
             return None

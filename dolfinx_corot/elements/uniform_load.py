@@ -1,0 +1,80 @@
+r"""Nodal loads equivalent to a uniform dead load on straight lines, triangles and quadrilaterals.
+
+A load :math:`\mathbf q` per unit *reference* length (beams, bars: self-weight
+:math:`\rho A \mathbf g`) or per unit reference area (shells, membranes:
+:math:`\rho t \mathbf g`) is replaced by its work-equivalent nodal loads,
+computed once from the reference geometry; they are dead (they keep their
+value and direction as the structure deforms), so the total weight is exact
+in every configuration.
+
+* Lines of length :math:`l_0` along :math:`\mathbf d_0 = \mathbf X_2 - \mathbf X_1`:
+  forces :math:`\mathbf q\,l_0/2` at each node (the work-equivalent of the linear
+  axial and the cubic transverse interpolation alike), and for bending elements the
+  moments
+
+  .. math::
+
+      \mathbf m_1 = -\mathbf m_2 = \frac{l_0}{12}\,\mathbf d_0\times\mathbf q ,
+
+  the fixed-end moments :math:`\pm q_\perp l_0^2/12` of the transverse part of the
+  load (Przemieniecki 1968, §5.6; also for the exact Timoshenko element, whose
+  fixed-end moments under a uniform load are those of the Bernoulli beam). With
+  them a geometrically linear beam's nodal displacements are exact (the cantilever's
+  tip deflection :math:`q L^4/8EI` with any number of elements). The moments keep
+  their reference value under large rotation, whereas the work-equivalent moments
+  of a rotated element are :math:`(l_0/12)\,\mathbf d\times\mathbf q`: between
+  collinear elements of equal length they cancel at the common node either way,
+  and the difference at the ends of a member and at kinks, of order :math:`q l_0^2`,
+  vanishes as :math:`O(h^2)` with refinement.
+* Triangles: a third of :math:`\mathbf q A_0` at each node (exact for the linear
+  membrane interpolation; the usual lumping for the DKT plate part).
+* Quadrilaterals: :math:`\mathbf q\int N_a\,dA_0`, bilinear :math:`N_a`, 2×2 Gauss
+  points (exact for flat quadrilaterals; the same rule gives the area of warped ones).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def line_loads(X: np.ndarray, q: np.ndarray, bending: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Nodal forces and moments of a uniform load on straight two-node elements.
+
+    X: (n, 2, g) reference node coordinates, g = 2 or 3; q: (g,) load per unit length;
+    bending: (n,) True for beams (moments added), False for bars.
+    Returns forces (n, 2, g) and moments (n, 2) in 2D (about z) or (n, 2, 3) in 3D.
+    """
+    d = X[:, 1] - X[:, 0]
+    length = np.linalg.norm(d, axis=1)
+    forces = np.repeat((0.5 * length[:, None] * q)[:, None, :], 2, axis=1)
+    if X.shape[2] == 2:
+        m = (d[:, 0] * q[1] - d[:, 1] * q[0]) * length / 12.0 * bending
+        moments = np.stack([m, -m], axis=1)
+    else:
+        m = np.cross(d, q) * (length / 12.0 * bending)[:, None]
+        moments = np.stack([m, -m], axis=1)
+    return forces, moments
+
+
+def triangle_loads(X: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Nodal forces (n, 3, 3) of a uniform load q (3,) per unit area on triangles X (n, 3, 3)."""
+    area = 0.5 * np.linalg.norm(np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]), axis=1)
+    return np.repeat((area[:, None] * q / 3.0)[:, None, :], 3, axis=1)
+
+
+#: 2×2 Gauss points on [0, 1] (weight 1/4 each)
+_GAUSS = 0.5 + np.array([-0.5, 0.5]) / np.sqrt(3.0)
+
+
+def quad_loads(X: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Nodal forces (n, 4, 3) of a uniform load q (3,) per unit area on bilinear quadrilaterals
+    X (n, 4, 3) whose nodes are in DOLFINx's order (0, 0), (1, 0), (0, 1), (1, 1) of the unit
+    square: ∫ N_a dA by 2×2 Gauss points."""
+    weights = np.zeros((len(X), 4))
+    for xi in _GAUSS:
+        for eta in _GAUSS:
+            N = np.array([(1 - xi) * (1 - eta), xi * (1 - eta), (1 - xi) * eta, xi * eta])
+            dxi = np.array([-(1 - eta), 1 - eta, -eta, eta])
+            deta = np.array([-(1 - xi), -xi, 1 - xi, xi])
+            jac = np.linalg.norm(np.cross(np.einsum("a,nai->ni", dxi, X), np.einsum("a,nai->ni", deta, X)), axis=1)
+            weights += 0.25 * jac[:, None] * N
+    return weights[:, :, None] * q

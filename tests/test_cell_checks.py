@@ -157,6 +157,14 @@ def test_mildly_warped_membrane_quadrilateral_is_accepted():
     dc.Scene().add_membrane(tm, "sail", thickness=0.01, material=dc.Elastic(1.0))
 
 
+def test_zero_length_beam_is_refused_in_the_same_terms():
+    tm = from_arrays(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [2.0, 0.0]]), [[0, 1], [1, 2], [2, 3]], "beam",
+                     comm=comm)
+    with pytest.raises(dc.MeshError, match=r"beam 'beam': 1 element\(s\) of zero length, the first at \(1, 0\) "
+                                           r"\(cell 1 in input order\)$"):
+        dc.Scene().add_beam(tm, "beam", section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(1.0))
+
+
 # -- geometry degree -----------------------------------------------------------------------
 def _quarter_disk(order, R=1.0, size=0.3):
     """A quarter disk of radius R meshed by gmsh with elements of ``order``; edge groups 'x_axis' and

@@ -16,6 +16,7 @@ from .amplitudes import Amplitude
 from .contact.laws import AugmentedLagrangian, ContactError, Penalty
 from .io.mesh import GroupNotFoundError, TaggedMesh, from_gmsh
 from .materials import Elastic, NeoHookean, SaintVenantKirchhoff
+from .parts import MeshError
 from .result import History, Result
 from .scene import Scene
 from .sections import Circle, Rectangle, Section
@@ -24,5 +25,5 @@ from .solvers import ArcLength, CheckpointError, ConvergenceError, LoadControl, 
 __version__ = "0.1.0"
 
 __all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "Penalty", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
-           "NeoHookean", "NewtonOptions", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
+           "MeshError", "NeoHookean", "NewtonOptions", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
            "rotations", "solve"]

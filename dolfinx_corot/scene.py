@@ -109,7 +109,9 @@ class Scene:
                   degree: int = 2) -> PartRef:
         """Large-deformation continuum (plane strain in 2D, or 3D) on the cells of group ``where``
         (all cells if None) of a mesh that fills its space; Lagrange elements of ``degree`` 1
-        or 2 on triangles, quadrilaterals, tetrahedra or hexahedra.
+        or 2 on triangles, quadrilaterals, tetrahedra or hexahedra. Degree 2 also takes gmsh's
+        second-order (curved) cells. Every cell is checked here: an inverted, self-intersecting
+        or degenerate cell raises dc.MeshError naming it (``dolfinx_corot.parts.cells``).
 
         material: dc.SaintVenantKirchhoff or dc.NeoHookean (dc.Elastic: St Venant–Kirchhoff).
         A named region given after the whole mesh takes its cells over: that is how one

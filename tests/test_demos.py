@@ -136,8 +136,9 @@ def test_restart_under_mpi_matches_serial(tmp_path):
 def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
     """Parts on several meshes (shared nodes across ranks), quadrilateral membranes, continua
     (AMG, reactions, exact homogeneous states), contact (patch test, sliding, penalty range),
-    checkpoint and restart (exact with contact multipliers; refusals), field output, and monitors
-    on groups (reductions, profiles, bodies that touch) on 2 ranks."""
+    checkpoint and restart (exact with contact multipliers; refusals), field output, monitors on groups
+    (reductions, profiles, bodies that touch), self-weight and the cell checks (the same refusal naming
+    the same cell on every rank) on 2 ranks."""
     # each rank's pytest gets a temporary root of its own (two cleaning one root race each other)
     for rank in range(2):
         (tmp_path / f"rank{rank}").mkdir()
@@ -146,7 +147,7 @@ def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
                 "no:cacheprovider", "--color=no", "tests/test_coupled.py", "tests/test_membrane_quad.py",
                 "tests/test_continuum.py", "tests/test_contact.py", "tests/test_restart.py", "tests/test_fields.py",
                 "tests/test_reference.py", "tests/test_bad_input.py", "tests/test_monitors.py",
-                "tests/test_self_weight.py"],
+                "tests/test_self_weight.py", "tests/test_cell_checks.py"],
                tmp_path)
     summaries = [line for line in out.splitlines() if " passed" in line and line.rstrip().endswith("s")]
     assert len(summaries) == 2, out[-3000:]

@@ -9,13 +9,14 @@ concrete part class.
 import numpy as np
 
 from .base import Motion, Part, PartRef, global_sum, owned_dofs_of_vertices
+from .cells import MeshError
 from .coupled import Coupled
 from .frame import Frame2D, Frame3D, LineFrame
 from .shell import MembraneQuad, Shell3D, Surface3D
 from .solid import Solid
 from .surface import Surface, SurfaceError
 
-__all__ = ["Coupled", "Frame2D", "Frame3D", "LineFrame", "MembraneQuad", "Motion", "Part", "PartRef", "Shell3D",
+__all__ = ["Coupled", "Frame2D", "Frame3D", "LineFrame", "MembraneQuad", "MeshError", "Motion", "Part", "PartRef", "Shell3D",
            "Solid", "Surface", "Surface3D", "SurfaceError", "global_sum", "owned_dofs_of_vertices", "part_for_mesh"]
 
 

@@ -29,6 +29,7 @@ from ..io.mesh import TaggedMesh
 from ..kernels import beam3d as kernels3d
 from ..kernels import line2d as kernels2d
 from .base import AdditiveState, Part, PartRef
+from .cells import MeshError, check_geometry_degree, mesh_extent, refuse
 from .surface import Surface, SurfaceError, gather_surface
 
 
@@ -48,6 +49,10 @@ class LineFrame(Part):
             raise ValueError(f"{type(self).__name__} needs a mesh of tdim {self.tdim} in gdim {self.gdim}; got "
                              f"tdim {mesh.topology.dim}, gdim {mesh.geometry.dim}: read the gmsh model "
                              f"with from_gmsh(model, gdim={self.gdim})")
+        check_geometry_degree(mesh, "beams, bars, shells and membranes", 1,
+                              "co-rotational beams, bars, shells and membranes are straight or flat elements on "
+                              "the corner nodes: mesh with first-order elements (gmsh.model.mesh.setOrder(1), the "
+                              "default), finer where the structure curves")
         self.tmesh = tmesh
         self.large_rotations = bool(large_rotations)
         self.V = dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=len(self.dof_names))
@@ -93,28 +98,20 @@ class LineFrame(Part):
         gdofs = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 2)[cells]
         return x[gdofs[:, 0]], x[gdofs[:, 1]] - x[gdofs[:, 0]]
 
-    def _refuse(self, cells: np.ndarray, bad: np.ndarray, points: np.ndarray, message: str) -> None:
-        """Raise ValueError(message) on every rank if any rank found bad cells.
+    def _refuse(self, cells: np.ndarray, bad: np.ndarray, message: str, error: type = MeshError) -> None:
+        """Raise ``error(message)`` on every rank if any rank found bad cells.
 
-        cells: the local cells checked; bad: indices into cells of the bad ones;
-        points: (len(cells), ≥gdim) a point of each cell for the message, which
-        may use {n} (number of bad cells, owned ones counted once) and {at}.
+        cells: the local cells checked; bad: indices into cells of the bad ones; the
+        message may use {n} (number of bad cells, owned ones counted once) and {at} (the
+        midpoint and input index of the bad cell that comes first in input order).
         """
-        owned = cells[bad] < self.tmesh.mesh.topology.index_map(self.tdim).size_local
-        first = points[bad[0], : self.gdim].tolist() if len(bad) else None
-        found = self.comm.allgather((int(np.sum(owned)), first))
-        total = sum(n for n, _ in found)
-        if total or any(f is not None for _, f in found):
-            at = next(f for _, f in found if f is not None)
-            raise ValueError(message.format(n=max(total, 1), at="(" + ", ".join(f"{c:.6g}" for c in at) + ")"))
+        refuse(self.tmesh.mesh, "", [(message, cells[bad])], error)
 
     def _check_geometry(self, cells: np.ndarray, label: str, props: np.ndarray) -> None:
-        start, d = self._element_vectors(cells)
+        _, d = self._element_vectors(cells)
         lengths = np.linalg.norm(d, axis=1)
-        x = self.tmesh.mesh.geometry.x
-        scale = max(float(np.ptp(x, axis=0).max()) if len(x) else 1.0, 1e-300)
-        bad = np.flatnonzero(lengths <= 1e-10 * scale)
-        self._refuse(cells, bad, start, f"{label}: {{n}} element(s) of zero length, the first at {{at}}")
+        bad = np.flatnonzero(lengths <= 1e-10 * mesh_extent(self.tmesh.mesh))
+        self._refuse(cells, bad, f"{label}: {{n}} element(s) of zero length, the first at {{at}}")
 
     def capture_reference(self) -> None:
         """Take the current configuration as the stress-free reference of the elements: the part's
@@ -397,9 +394,9 @@ class Frame3D(Rotations3D, LineFrame):
 
     def _check_geometry(self, cells, label, props):
         super()._check_geometry(cells, label, props)
-        start, d = self._element_vectors(cells)
+        _, d = self._element_vectors(cells)
         v = props[-3:]
         c = np.abs(d @ v) / (np.linalg.norm(d, axis=1) * np.linalg.norm(v))
         bad = np.flatnonzero(c > 1.0 - 1e-8)
-        self._refuse(cells, bad, start, f"{label}: the orientation vector {v.tolist()} is parallel to {{n}} "
-                     "element(s), the first at {at}; choose one that fixes the local y axis")
+        self._refuse(cells, bad, f"{label}: the orientation vector {v.tolist()} is parallel to {{n}} "
+                     "element(s), the first at {at}; choose one that fixes the local y axis", ValueError)

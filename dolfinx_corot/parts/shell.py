@@ -19,6 +19,7 @@ from ..io.mesh import TaggedMesh
 from ..kernels import membrane_quad as kernels_mq
 from ..kernels import shell3d as kernels_shell
 from .base import PartRef
+from .cells import mesh_extent, quadrilateral_problems, refuse, triangle_problems
 from .frame import Frame3D, LineFrame, Rotations3D
 
 
@@ -82,12 +83,11 @@ class Shell3D(Surface3D):
         return self.add_elements(where, np.array([E, nu, thickness, 0.0, 0.0, 0.0]), False, "membrane")
 
     def _check_geometry(self, cells, label, props):
-        x = self.tmesh.mesh.geometry.x
-        g = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 3)[cells]
-        area = 0.5 * np.linalg.norm(np.cross(x[g[:, 1]] - x[g[:, 0]], x[g[:, 2]] - x[g[:, 0]]), axis=1)
-        scale = max(float(np.ptp(x, axis=0).max()) if len(x) else 1.0, 1e-300)
-        bad = np.flatnonzero(area <= 1e-10 * scale**2)
-        self._refuse(cells, bad, x[g[:, 0]], f"{label}: {{n}} triangle(s) of zero area, the first at {{at}}")
+        """Refuse triangles of zero size or area (MeshError naming the first)."""
+        mesh = self.tmesh.mesh
+        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 3)[cells]]
+        problems = triangle_problems(X, mesh_extent(mesh))
+        refuse(mesh, label, [(problem, cells[bad]) for problem, bad in problems])
 
 
 class MembraneQuad(Surface3D):
@@ -109,14 +109,10 @@ class MembraneQuad(Surface3D):
         return self.add_elements(where, np.array([E, nu, thickness]), False, "membrane")
 
     def _check_geometry(self, cells, label, props):
-        x = self.tmesh.mesh.geometry.x
-        g = self.tmesh.mesh.geometry.dofmap.array.reshape(-1, 4)[cells][:, kernels_mq.CCW]
-        n = np.cross(x[g[:, 2]] - x[g[:, 0]], x[g[:, 3]] - x[g[:, 1]])
-        # convexity: each corner turns the same way about the element normal
-        ok = np.ones(len(g), dtype=bool)
-        for a in range(4):
-            e0 = x[g[:, (a + 1) % 4]] - x[g[:, a]]
-            e1 = x[g[:, (a + 2) % 4]] - x[g[:, (a + 1) % 4]]
-            ok &= np.einsum("ij,ij->i", np.cross(e0, e1), n) > 0.0
-        self._refuse(cells, np.flatnonzero(~ok), x[g[:, 0]], f"{label}: {{n}} quadrilateral(s) not convex, of zero "
-                     "area or with nodes out of order, the first at {at}")
+        """Refuse quadrilaterals of zero size or area, self-intersecting, not convex, with three
+        corners on a line or strongly warped (MeshError naming the first; see
+        :func:`dolfinx_corot.parts.cells.quadrilateral_problems`)."""
+        mesh = self.tmesh.mesh
+        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 4)[cells][:, kernels_mq.CCW]]
+        problems = quadrilateral_problems(X, mesh_extent(mesh))
+        refuse(mesh, label, [(problem, cells[bad]) for problem, bad in problems])

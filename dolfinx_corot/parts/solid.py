@@ -10,6 +10,9 @@ the forms
 
 with P the first Piola–Kirchhoff stress of the law (``continuum.laws``), or
 the small-strain stress when the scene has ``large_rotations=False``.
+The mesh geometry may be of the solid's degree at most (degree 2: gmsh's
+second-order, curved cells); every cell is checked at creation
+(:func:`~dolfinx_corot.parts.cells.check_solid_cells`).
 External loads are dead: tractions per reference area on facet groups,
 body forces per reference volume, point forces at nodes. It presents the
 same part protocol (:class:`dolfinx_corot.parts.base.Part`) as the structural
@@ -38,6 +41,7 @@ from ..continuum.laws import first_piola, lame
 from ..io.mesh import TaggedMesh
 from ..materials import Elastic
 from .base import AdditiveState, Part, PartRef, finite_vector
+from .cells import check_geometry_degree, check_solid_cells
 from .surface import Surface, SurfaceError, gather_surface
 
 CELLS = ("triangle", "quadrilateral", "tetrahedron", "hexahedron")
@@ -60,6 +64,12 @@ class Solid(AdditiveState, Part):
                              f"tdim {mesh.topology.dim}, gdim {mesh.geometry.dim}: {advice}")
         if degree not in (1, 2):
             raise ValueError(f"solid: degree {degree} is not 1 or 2")
+        check_geometry_degree(mesh, f"solid of degree {degree}", degree,
+                              "a solid's geometry may be of its own degree at most (degree 2: straight or "
+                              "curved cells; degree 1: straight cells): give degree=2, or mesh with first-order "
+                              "elements (gmsh.model.mesh.setOrder(1))" if degree == 1 else
+                              "solids take geometry of degree 1 or 2: mesh with gmsh.model.mesh.setOrder(2) or 1")
+        check_solid_cells(tmesh, "solid mesh")
         self.tmesh = tmesh
         self.degree = degree
         self.large_rotations = bool(large_rotations)

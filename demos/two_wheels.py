@@ -30,10 +30,10 @@
 # What makes it run through: the master surfaces are smooth (C¹ Hermite
 # curves through the nodes), so a slave sliding from one segment to the
 # next sees no jump of the normal, and Newton's iterates are kept in check
-# near contact (line search; a correction that would carry a contact node
-# further than half a segment is shortened; after an iteration that raised
-# the residual, the next tangent keeps only the positive part of each pair's
-# tangent). With straight segments and plain Newton the same run stops at
+# near contact (line search; a correction that would slide a contact node
+# along its master by more than half a segment is shortened; after an
+# iteration that raised the residual, the next tangent keeps only the
+# positive part of each pair's tangent). With straight segments and plain Newton the same run stops at
 # λ ≈ 0.45.
 #
 # Checked: every step converges without a cut; at most 5 Uzawa updates

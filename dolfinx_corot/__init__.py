@@ -14,6 +14,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
 from . import rotations  # noqa: E402
 from .amplitudes import Amplitude
 from .contact.laws import AugmentedLagrangian, ContactError, Penalty
+from .contact.pair import ContactPair
 from .io.mesh import GroupNotFoundError, TaggedMesh, from_gmsh
 from .materials import Elastic, NeoHookean, SaintVenantKirchhoff
 from .parts import MeshError
@@ -24,6 +25,6 @@ from .solvers import ArcLength, CheckpointError, ConvergenceError, LoadControl, 
 
 __version__ = "0.1.0"
 
-__all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "Penalty", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
+__all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "ContactPair", "Penalty", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
            "MeshError", "NeoHookean", "NewtonOptions", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
            "rotations", "solve"]

@@ -24,6 +24,7 @@ import numpy as np
 
 from .contact.interface import Contact, Interface
 from .contact.laws import Penalty
+from .contact.pair import ContactPair
 from .io.mesh import TaggedMesh
 from .materials import Elastic
 from .parts import Coupled, Part, PartRef, part_for_mesh
@@ -55,7 +56,7 @@ class Monitor:
     name: str
     part: PartRef
     where: str
-    kind: str = "dofs"  # or "reaction"
+    kind: str = "dofs"  # or "reaction", or "contact" (part: a ContactPair, where: its side)
     reduce: str | None = None
     along: object = None
 
@@ -289,13 +290,18 @@ class Scene:
         smooth: the master surface is the C¹ Hermite curve through its nodes (normals continuous
         from segment to segment: robust sliding over curved and deforming masters); False: the
         straight segments (slave forces shared linearly by the segment's two nodes: the patch
-        test is passed exactly). Returns the interfaces made."""
+        test is passed exactly).
+
+        Returns a :class:`~dolfinx_corot.contact.ContactPair`, the sequence of the interfaces made
+        (one, or two when symmetric), which gives the interface pressure of both passes combined
+        on either side's contact face (``pair.pressure(on="slaves")``, a beam's face at half its
+        depth) and its resultant; see also :meth:`monitor_contact`."""
         law = Penalty() if law is None else law
         made = [Interface(slaves, masters, law, smooth)]
         if symmetric:
             made.append(Interface(masters, slaves, law, smooth))
         self.interfaces += made
-        return made
+        return ContactPair(made)
 
     def monitor(self, name: str, part: PartRef, where: str, reduce: str | None = None, along=None) -> None:
         """Record the dofs of the nodes of group ``where`` after every step.
@@ -341,7 +347,9 @@ class Scene:
         self._groups[(name, "dofs")] = group
 
     def _add_monitor(self, monitor: Monitor) -> None:
-        taken = [m for m in self.monitors if m.name == monitor.name and m.kind == monitor.kind]
+        # reactions and contact monitors share the columns name_Fx, name_Fy
+        taken = [m for m in self.monitors if m.name == monitor.name and (
+            m.kind == monitor.kind or {m.kind, monitor.kind} == {"reaction", "contact"})]
         if taken:
             raise ValueError(f"monitor '{monitor.name}' exists already (on group '{taken[0].where}'): give each "
                              "monitor a name of its own (its history columns carry it)")
@@ -353,6 +361,18 @@ class Scene:
         (2D) or name_Fx … name_Mz (3D)."""
         part.model.tmesh.vertices(where)  # fails early for a missing group
         self._add_monitor(Monitor(name, part, where, "reaction"))
+
+    def monitor_contact(self, name: str, pair: ContactPair, on: str = "slaves") -> None:
+        """Record, after every step, the contact of ``pair`` (what :meth:`contact` returned) on its
+        ``on`` side ('slaves' or 'masters'), both passes combined: ``name_Fx``, ``name_Fy`` the
+        resultant force the other body exerts on that side, ``name_N`` the total normal force
+        Σ p L and ``name_pmax`` the largest nominal pressure on the contact face."""
+        if not isinstance(pair, ContactPair):
+            raise TypeError(f"monitor_contact '{name}': give what scene.contact returned, got {type(pair).__name__}")
+        if not any(pair.interfaces[0] is itf for itf in self.interfaces):
+            raise ValueError(f"monitor_contact '{name}': contact '{pair.name}' belongs to another scene")
+        pair._side(on)
+        self._add_monitor(Monitor(name, pair, on, "contact"))
 
     # -- introspection -----------------------------------------------------------
     @property
@@ -397,6 +417,9 @@ class Scene:
         (``system`` holds f_int), by history column."""
         values = {}
         for mon in self.monitors:
+            if mon.kind == "contact":  # part: the ContactPair, where: its side
+                values.update(mon.part.monitor_values(mon.name, mon.where))
+                continue
             model = mon.part.model
             if mon.kind == "reaction":
                 # reaction on the structure = λ f_ext − f_int at the constrained nodes

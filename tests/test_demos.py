@@ -145,8 +145,8 @@ def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
     per_rank = f'PYTEST_DEBUG_TEMPROOT="{tmp_path}/rank$OMPI_COMM_WORLD_RANK" exec "$@"'
     out = _run(["mpirun", "-n", "2", "sh", "-c", per_rank, "sh", sys.executable, "-m", "pytest", "-q", "-p",
                 "no:cacheprovider", "--color=no", "tests/test_coupled.py", "tests/test_membrane_quad.py",
-                "tests/test_continuum.py", "tests/test_contact.py", "tests/test_restart.py", "tests/test_fields.py",
-                "tests/test_reference.py", "tests/test_bad_input.py", "tests/test_monitors.py",
+                "tests/test_continuum.py", "tests/test_contact.py", "tests/test_contact_pressure.py", "tests/test_restart.py",
+                "tests/test_fields.py", "tests/test_reference.py", "tests/test_bad_input.py", "tests/test_monitors.py",
                 "tests/test_self_weight.py", "tests/test_cell_checks.py"],
                tmp_path)
     summaries = [line for line in out.splitlines() if " passed" in line and line.rstrip().endswith("s")]

@@ -19,7 +19,9 @@ all candidate pairs (entries on constrained dofs are left out), added to
 the system matrix. The pattern is rebuilt only when the candidate set
 grows (a slave moves more than half the margin since the last search).
 
-The laws are in :mod:`.laws`. :class:`Contact` is the interfaces of a scene as one
+The interface pressure of a contact declaration (both passes of two-pass contact, on the
+actual contact faces) is in :mod:`.pair`. The laws are in :mod:`.laws`. :class:`Contact` is the
+interfaces of a scene as one
 :class:`~dolfinx_corot.assembly.contribution.Contribution` of the system: its Newton
 hooks are the safeguards near contact and the Uzawa updates, its state the
 multipliers and the candidate pairs.
@@ -120,6 +122,10 @@ class Interface:
                     else np.column_stack([sm[:, 0], sm[:, 0], sm[:, 1], sm[:, 1]]))
         self.multiplier = np.zeros(len(self.area))
         self.margin = 0.5 * self.h
+        # the interface's extent (its two surfaces' joint bounding box): no Newton correction
+        # separates a slave from its master by more than this
+        both = np.vstack([self.slave.X, Xm])
+        self.size = float(np.linalg.norm(both.max(axis=0) - both.min(axis=0)))
         self.touch = 1e-6 * self.h  # a gap below this keeps the penalty stiffness (no force)
         self.uzawa_updates = 0
 
@@ -227,6 +233,7 @@ class Interface:
             self._virtual = (s[pull], m[pull],
                              -(self.area[s[pull]] * (lam[pull] - self.penalty * g[pull]))[:, None] * normal[pull])
         self._last = (s, g)
+        self._x = (xs, xm)
         self._forces = (s[keep], m[keep], f[keep])
         return dofs[keep], f[keep], K[keep], (s[keep], m[keep])
 
@@ -317,6 +324,71 @@ class Interface:
                 "smooth": self.smooth, "penalty": self.penalty, "slave_nodes": len(self.area),
                 "master_segments": len(self.master.facets)}
 
+    def correction_ratio(self, ds: np.ndarray, dm: np.ndarray) -> float:
+        """How far a Newton correction (ds (n_slaves, 2), dm (n_master, 2) of all nodes) moves this
+        rank's slaves relative to their masters, as a multiple of what is allowed (≤ 1: allowed).
+
+        The motion of a slave relative to the point of the master surface it faces,
+        Δr = Δx_s − Δx_master(ξ), is split along the master's normal n and tangent:
+
+        * sliding (tangential) at most the search margin, half a master segment: further, the
+          closest point and the active set change several times within one linearization;
+        * approach at most the current gap plus the margin: the slave ends at most half a
+          segment inside the master (a pair is a partner down to one segment length inside);
+        * separation at most the interface's extent.
+
+        A slave without a partner (open beyond the margin, or beyond a free end) is referred to its
+        nearest master node: it may approach it by its distance, slide by that plus the margin.
+        Bodies that move together (a lining pressed into soft ground with the soil's surface)
+        are not held back: only relative motion counts, whatever the size of the correction."""
+        if not len(self.mine):
+            return 0.0
+        xs, xm = self._x
+        segment, mode, sides = self._assigned
+        seg = self.master.facets
+        mine = self.mine
+        sm = segment[mine]
+        worst = 0.0
+        gap = np.full(len(self.area), np.inf)
+        s_last, g_last = self._last
+        gap[s_last] = g_last
+        # slaves facing a master segment (mode 0) or vertex (mode 1, 2)
+        on = mine[(sm >= 0) & (mode[mine] == 0)]
+        if len(on):
+            m = segment[on]
+            a, b = seg[m, 0], seg[m, 1]
+            d = xm[b] - xm[a]
+            l2 = np.einsum("ij,ij->i", d, d)
+            xi = np.clip(np.einsum("ij,ij->i", xs[on] - xm[a], d) / l2, 0.0, 1.0)
+            rel = ds[on] - ((1.0 - xi)[:, None] * dm[a] + xi[:, None] * dm[b])
+            t = d / np.sqrt(l2)[:, None]
+            n = sides[on][:, None] * np.column_stack([t[:, 1], -t[:, 0]])  # towards the slave's side
+            worst = max(worst, self._ratio(rel, n, np.maximum(gap[on], 0.0) + self.margin, self.margin))
+        at = mine[(sm >= 0) & (mode[mine] > 0)]
+        if len(at):
+            m = segment[at]
+            v = seg[m, mode[at] - 1]
+            u = xs[at] - xm[v]
+            u /= np.maximum(np.linalg.norm(u, axis=1), 1e-300)[:, None]
+            worst = max(worst, self._ratio(ds[at] - dm[v], u, np.maximum(gap[at], 0.0) + self.margin, self.margin))
+        free = mine[sm < 0]
+        if len(free):
+            from scipy.spatial import cKDTree
+
+            dist, v = cKDTree(xm).query(xs[free])
+            u = (xs[free] - xm[v]) / np.maximum(dist, 1e-300)[:, None]
+            worst = max(worst, self._ratio(ds[free] - dm[v], u, np.maximum(dist, self.margin),
+                                           dist + self.margin))
+        return worst
+
+    def _ratio(self, rel, n, approach, slide) -> float:
+        """Largest of |sliding| / slide, approach / approach and separation / extent over the
+        relative corrections rel (k, 2) with unit normals n (k, 2) pointing to the slaves."""
+        normal = np.einsum("ij,ij->i", rel, n)
+        sliding = np.linalg.norm(rel - normal[:, None] * n, axis=1)
+        ratio = np.maximum(sliding / slide, np.maximum(-normal / approach, normal / self.size))
+        return float(ratio.max(initial=0.0))
+
     def gaps(self) -> tuple[np.ndarray, np.ndarray]:
         """(slave indices, gaps) of this rank's slaves that have a master segment now."""
         return self._last
@@ -343,10 +415,12 @@ class Interface:
         return True
 
     def pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
-        """Coordinates (n, 2) and contact pressure (n,) of all slave nodes, on every rank, at the
-        last evaluation: the nominal pressure ⟨λ − ε g⟩ per reference length with the reference
-        coordinates, or (``current``) the true pressure, the nodal force per current tributary
-        length, with the current coordinates."""
+        """Coordinates (n, 2) and contact pressure (n,) of all slave nodes of this pass, on every
+        rank, at the last evaluation: the nominal pressure ⟨λ − ε g⟩ per reference length with the
+        reference coordinates, or (``current``) the nodal force per current tributary length of the
+        slave surface (a beam's axis), with the current coordinates. In two-pass contact this is
+        one pass's share; :meth:`ContactPair.pressure <dolfinx_corot.contact.ContactPair.pressure>`
+        gives the interface pressure (both passes, on the actual contact face)."""
         s, g = self._last
         p = np.zeros(len(self.area))
         p[s] = np.maximum(0.0, self.multiplier[s] - self.penalty * g)
@@ -358,8 +432,9 @@ class Interface:
         return x, out * self.area / _tributary_lengths(x, self.slave.facets)
 
     def master_pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
-        """Contact pressure on the master side: the contact forces on each master node over its
-        tributary length (n_master,), with the nodes' coordinates (n_master, 2), on every rank."""
+        """Contact pressure on the master side of this pass: the contact forces on each master node
+        over its tributary length of the master surface (n_master,), with the nodes' coordinates
+        (n_master, 2), on every rank (see :meth:`pressure` for the interface pressure)."""
         s, m, f = self._forces
         seg = self.master.facets
         force = np.zeros((len(self.master.X), 2))
@@ -386,7 +461,8 @@ class Contact(Contribution):
     10 × 10 dof blocks are the declared couplings. Newton hooks: a Newton solve's
     first tangent is exact; after a rise of the residual the next tangent keeps
     the positive part of each pair's tangent; corrections are capped so that no
-    contact node moves more than its interface's search margin; the line search
+    slave slides more than half a master segment relative to its master (the normal approach of
+    bodies moving together is free, see :meth:`Interface.correction_ratio`); the line search
     is asked for while any pair is a candidate; lifted pairs of bodies that were
     touching may count as closed for a few corrections (:meth:`correction_rhs`);
     after convergence, Uzawa updates of augmented-Lagrangian multipliers.
@@ -477,22 +553,28 @@ class Contact(Contribution):
         return np.concatenate(dofs), np.concatenate(forces)
 
     def limit_correction(self, dx) -> float:
-        """A factor ≤ 1 for the Newton correction ``dx`` that keeps every contact node's motion
-        within its interface's search margin (half a master segment): a correction that would
-        carry a node several segments along a surface comes from a tangent linearized far from
-        there (e.g. indefinite at an intermediate iterate) and is shortened; the next
-        iterations continue from the shorter step."""
+        """A factor ≤ 1 for the Newton correction ``dx`` that keeps every slave's motion relative to
+        its master within bounds (:meth:`Interface.correction_ratio`): sliding at most half a
+        master segment — a correction that would carry a slave several segments along a surface
+        comes from a tangent linearized far from there (e.g. indefinite at an intermediate
+        iterate) and is shortened, the next iterations continue from the shorter step — and
+        approach at most to half a segment inside the master. The normal approach of bodies that
+        move together (a beam or lining pressed into soft ground) is not limited."""
         if not self._engaged:
             return 1.0
         start, stop = dx.getOwnershipRange()
         values = dx.getArray(readonly=True)
         worst = 0.0
         for itf in self.interfaces:
+            moves = []
             for gd in (itf.slave_gdofs, itf.master_gdofs):
-                own = ((gd >= start) & (gd < stop)).all(axis=1)
-                if own.any():
-                    d = values[gd[own] - start]
-                    worst = max(worst, float(np.sqrt((d * d).sum(axis=1)).max()) / itf.margin)
+                own = (gd >= start) & (gd < stop)
+                d = np.zeros(gd.shape)
+                d[own] = values[gd[own] - start]
+                total = np.zeros_like(d)
+                self.comm.Allreduce(d, total, op=MPI.SUM)
+                moves.append(total)
+            worst = max(worst, itf.correction_ratio(*moves))
         worst = self.comm.allreduce(worst, op=MPI.MAX)
         return 1.0 if worst <= 1.0 else 1.0 / worst
 

@@ -54,23 +54,25 @@ import numpy as np
 from mpi4py import MPI
 
 import dolfinx.fem
-import dolfinx.fem.petsc
 
 from . import validate
+from .assembly import petsc
 from .assembly.contribution import Contribution
 from .parts import PartRef
 
 logger = logging.getLogger(__name__)
 
-WARN_FORCE = 1e-3  # springs that still carry this fraction of the load at the end of a step are reported
-# re-anchoring stops early when the springs' force, below this fraction of the load, no longer halves
-# from one re-anchoring to the next: it drives a motion that nothing holds (a frictionless ring's spin)
-DRIFT = 1e-6
+# springs whose force, below this fraction of the load, no longer halves from one re-anchoring to the
+# next hold a motion that nothing else holds (a frictionless ring's spin driven by the discretisation of
+# contact): re-anchoring stops, the force is reported; above it the body is taken to be on its way
+# across a gap (re-anchoring goes on), and a step that ends so is reported with a warning
+FREE_FORCE = 1e-3
 
 
 class Stabiliser:
-    """The springs of one part (see the module docstring): made by ``Scene.stabilise``, kept by the
-    scene (its dissipated work carries over from run to run), bound to each system that solves it.
+    """The springs of one part (see the module docstring): made by ``Scene.stabilise`` and kept by the
+    scene; bound to each system that solves it (anchors at the configuration then, work from zero;
+    the stiffness, once computed, is kept).
 
     part: the part (from ``Scene.add_*``); where: a group of the part's mesh (None: every node of
     the part's cells); stiffness: translational spring per node (force per length; None: ``factor``
@@ -86,7 +88,7 @@ class Stabiliser:
         if not isinstance(part, PartRef):
             raise TypeError(f"stabilise: part must be a part of the scene (from Scene.add_*), got "
                             f"{type(part).__name__}")
-        self.label = f"{part.kind} '{part.name or 'all cells'}'"
+        self.label = f"{part.kind} '{part.name or 'all cells'}'" + ("" if where is None else f" at {where!r}")
         owner = f"stabilise {self.label}"
         validate.positive(owner, "stiffness", stiffness, allow_none=True)
         validate.positive(owner, "rotational_stiffness", rotational_stiffness, allow_zero=True, allow_none=True)
@@ -158,14 +160,8 @@ class Stabiliser:
         model = self.model
         given = {False: self.stiffness, True: self.rotational_stiffness}
         if any(given[bool(r)] is None for r in self.rotational):
-            A = dolfinx.fem.petsc.assemble_matrix(model.forms()[1])
-            A.assemble()
-            diag = A.getDiagonal()
-            d = diag.array.copy()
-            diag.destroy()
-            A.destroy()
-            local = d[self.blocks[:, None] * model.ndof + self.components[None, :]] if len(self.blocks) else \
-                np.zeros((0, len(self.components)))
+            d = petsc.form_diagonal(model.forms()[1])
+            local = d[self.blocks[:, None] * model.ndof + self.components[None, :]]
         out = np.zeros(len(self.components))
         for rot in (False, True):
             cols = self.rotational == rot
@@ -218,7 +214,7 @@ class Stabiliser:
         dofs = ", ".join(self.model.dof_names[c] for c in self.components)
         k = "factor {:.3g} of the part's stiffness".format(self.factor) if self.stiffness is None else \
             f"k = {self.stiffness:.3g}"
-        return (f"stabilisation of {self.label}{'' if self.where is None else f' at {self.where!r}'}: springs to "
+        return (f"stabilisation of {self.label}: springs to "
                 f"ground on {dofs} of {self.nodes} nodes ({k}), re-anchored until they carry "
                 f"{self.tolerance:.0e} of the load")
 
@@ -281,13 +277,13 @@ class Stabilisation(Contribution):
             force = s.force_norm()
             s.last_force = force / ref if ref > 0.0 else (0.0 if force == 0.0 else math.inf)
             s.peak = max(s.peak, s.last_force)
-            stalled = s.updates > 0 and DRIFT > s.last_force > 0.5 * s.previous
+            stalled = s.updates > 0 and FREE_FORCE > s.last_force > 0.5 * s.previous
             s.previous = s.last_force
             if s.last_force > s.tolerance and s.updates < s.max_updates and not stalled:
                 s.reanchor()
                 s.updates += 1
                 again = True
-            elif s.last_force > WARN_FORCE:
+            elif s.last_force > FREE_FORCE:
                 logger.warning("stabilisation of %s: after %d re-anchorings its springs still carry %.3g of the "
                                "load: the part is not held (yet) in some loaded direction", s.label, s.updates,
                                s.last_force)

@@ -24,8 +24,8 @@
 # size. A frictionless ring in a circular hole could moreover spin freely.
 # `scene.stabilise(lining)` adds weak springs to ground on the lining's
 # nodes, k (u − a), with k a millionth of the lining's own stiffness (its mean
-# tangent diagonal) and the anchor a at the last converged configuration;
-# after every converged solve the anchors follow the lining and the solve is
+# tangent diagonal) and the anchor a where they were last released; after
+# every converged solve the anchors follow the lining and the solve is
 # repeated until the springs carry nothing (proximal-point steps,
 # Rockafellar 1976). The lining falls onto the bottom of the hole in the
 # first solve, the springs are released, and the answer is that of the model
@@ -43,16 +43,17 @@
 # Measured (8 steps, factor 10⁻⁶): the lining's centroid settles by 9.34 cm
 # (it follows the soil under gravity and the surcharge; crown and invert
 # nodes by 10.45 and 8.18 cm) and the ground ovalises it by 2.25 cm; 7–11
-# Newton iterations per step, 2–4 re-anchorings, 1.5 s; the springs' work is
-# 6·10⁻⁴ of the external work. Factor 10⁻⁵: the same answer to five digits,
+# Newton iterations per step, 2–4 re-anchorings, 1 s; the springs' work is
+# 6·10⁻⁴ of the external work. Factor 10⁻⁵: the same answer to six digits,
 # 99 iterations, work 5·10⁻³. A frictionless lining has no stiffness against
 # spin, and the discretised contact (32 lining nodes on 48 cavity segments)
-# drives it by a small torque: with factor 10⁻⁶ the springs hold it,
-# keeping a force of 3·10⁻⁶ of the load (reported as `stab_force`; the lining
-# turns by 2·10⁻⁴ rad); with factor 10⁻⁷ they let it roll by 1.9° into
-# another equilibrium of the frictionless model, where they carry nothing —
-# settlement and ovalisation within 0.2 % of the others. Friction, or a
-# fixed point of the lining, would hold the spin.
+# drives it by a small torque: with factor 10⁻⁶ the springs hold it with a
+# force of 2·10⁻⁶ of the load at most (reported as `stab_force`; the lining
+# turns by 1.5·10⁻⁴ rad); with factor 10⁻⁷ they let it roll by 1.9° into
+# another equilibrium of the frictionless model — settlement and
+# ovalisation within 0.2 % of the others. Friction, or a fixed point of the
+# lining, would hold the spin. Gaps are closed under load control: under
+# arc-length the free fall of the lining would fill the arc.
 
 # %%
 import logging

@@ -245,8 +245,8 @@ class Scene:
         """Weak springs to ground on the nodes of ``part`` (of its group ``where``, if given) for a body
         that is free until contact closes (a lining in a larger hole, a block above its support, a
         frictionless ring that may spin): k (u − a) on the translations (and the planar rotations of
-        2D structures) with the anchor a at the last converged configuration; after each
-        converged solve the anchors follow the body and the solve is repeated while the springs
+        2D structures) with the anchor a where they were last released; after each converged
+        solve the anchors follow the body and the solve is repeated while the springs
         carry more than ``tolerance`` times the load (at most ``max_updates`` times a step), so
         the converged answer is that without springs once the body is held
         (:mod:`dolfinx_corot.stabilisation`).

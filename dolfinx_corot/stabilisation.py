@@ -11,11 +11,11 @@ stabilised part a spring to ground that acts on the motion since an *anchor*
 
 .. math:: \mathbf f_s = k\,(\mathbf u - \mathbf a), \qquad \mathbf K_s = k\,\mathbf I,
 
-with the anchor at the configuration of the last converged step. After every
-converged Newton solve whose spring forces exceed ``tolerance`` times the
-residual's reference force (the larger of the load and internal-force norms,
-as Newton's own test), the anchors move to the current configuration and
-Newton solves again at the same load factor. Each solve is a step of the
+with the anchor at the configuration where the springs were last released (at
+first the initial one). After every converged Newton solve whose spring
+forces exceed ``tolerance`` times the residual's reference force (the larger
+of the load and internal-force norms, as Newton's own test), the anchors move
+to the current configuration and Newton solves again at the same load factor. Each solve is a step of the
 proximal-point method (Rockafellar 1976) on the total potential,
 :math:`\min_u \Pi(u) + \tfrac12 k\,|u - a|^2`, whose fixed points are the
 equilibria of the model without springs:
@@ -29,14 +29,22 @@ equilibria of the model without springs:
   CONTROLS, STABILIZE``), here on the increment of each solve rather than on a
   velocity; at most ``max_updates`` re-anchorings are made per step;
 * the tangent keeps k I throughout, so rigid motions that contact leaves free
-  and no load drives (a frictionless ring spinning in a circular hole) stay
-  regular and carry no force.
+  (a frictionless ring spinning in a circular hole) stay regular; when a
+  small force drives such a motion (the torque of discretised contact on the
+  ring) and, below ``FREE_FORCE`` of the load, no longer halves from one
+  re-anchoring to the next, re-anchoring stops and the springs hold it — the
+  force is reported, and a step that ends with more than ``FREE_FORCE`` on
+  the springs is reported with a warning (the part is not held).
 
-The springs absorb the work :math:`\tfrac12 k\,|u - a|^2` in each solve, released
-(dissipated) at each re-anchoring; its sum and the springs' force relative to
-the load at the end of each step are history columns (``stab_work``,
-``stab_force``; ``stab_peak`` the largest relative force in the step before
-re-anchoring, ``stab_updates`` the re-anchorings).
+Rotations of 3D structures (quaternion states) carry no springs: the
+translational springs remove the rigid motions of any part whose nodes are
+not on one line (the twist of a single straight 3D member stays free).
+
+The springs absorb the work :math:`\tfrac12 k\,|u - a|^2`, released (dissipated) at
+each re-anchoring; its sum (released and still held) and the springs' force
+relative to the load at the end of each step are history columns
+(``stab_work``, ``stab_force``; ``stab_peak`` the largest relative force in
+the step before re-anchoring, ``stab_updates`` the re-anchorings).
 
 Default spring stiffness: ``factor`` times the mean diagonal entry of the part's
 own tangent over its translational (rotational) dofs, computed once when the
@@ -63,9 +71,8 @@ from .parts import PartRef
 logger = logging.getLogger(__name__)
 
 # springs whose force, below this fraction of the load, no longer halves from one re-anchoring to the
-# next hold a motion that nothing else holds (a frictionless ring's spin driven by the discretisation of
-# contact): re-anchoring stops, the force is reported; above it the body is taken to be on its way
-# across a gap (re-anchoring goes on), and a step that ends so is reported with a warning
+# next hold a motion that nothing else holds: re-anchoring stops; above it the body is taken to be on
+# its way across a gap (re-anchoring goes on), and a step that ends so is reported with a warning
 FREE_FORCE = 1e-3
 
 
@@ -199,6 +206,20 @@ class Stabiliser:
         s = self.stretch()
         return 0.5 * self.model.comm.allreduce(float((self.k * s * s).sum()), op=MPI.SUM)
 
+    def anchor_array(self) -> np.ndarray:
+        """The anchors as a node-ordered (n_nodes, ndof) array of the part's model (0 on other dofs and
+        nodes; partition-independent), on every rank."""
+        model = self.model
+        imap = model.V.dofmap.index_map
+        local = np.zeros((imap.size_local + imap.num_ghosts, model.ndof))
+        local[np.ix_(self.blocks, self.components)] = self.anchor
+        return model.comm.bcast(model.to_global(local), root=0)
+
+    def set_anchor_array(self, values: np.ndarray) -> None:
+        """The anchors from :meth:`anchor_array`'s output."""
+        local = self.model.from_global(np.asarray(values, dtype=float)).reshape(-1, self.model.ndof)
+        self.anchor = local[np.ix_(self.blocks, self.components)].copy()
+
     def reanchor(self) -> None:
         """The springs release their work (it is dissipated) and restart from the current configuration."""
         self.work += self.energy()
@@ -224,9 +245,10 @@ class Stabilisation(Contribution):
 
     Residual k (u − a) and tangent k I on each stabilised dof (1 × 1 blocks); after a converged
     Newton solve, the anchors of springs whose force exceeds their tolerance move to the current
-    configuration and the solve is repeated (:meth:`on_converged`). State: the anchors and the
-    dissipated work (for files the work and the springs' stiffness; the anchors are the
-    configuration of the step the file is written at)."""
+    configuration and the solve is repeated (:meth:`on_converged`). The anchors move only so: a
+    step that ends with the springs holding a force (a motion nothing else holds) starts the next
+    one in equilibrium with them. State: the anchors and the released work (for files also the
+    springs' stiffness)."""
 
     name = "stabilisation"
 
@@ -290,17 +312,15 @@ class Stabilisation(Contribution):
         return again
 
     def history(self, report) -> dict:
-        return {"stab_work": sum(s.work for s in self.stabilisers),
+        """stab_work: the work the springs absorbed so far (released and still held); stab_force: their
+        force over the reference force at the step's end; stab_peak: the largest in the step;
+        stab_updates: re-anchorings in the step."""
+        return {"stab_work": sum(s.work + s.energy() for s in self.stabilisers),
                 "stab_force": max(s.last_force for s in self.stabilisers),
                 "stab_peak": max(s.peak for s in self.stabilisers),
                 "stab_updates": sum(s.updates for s in self.stabilisers)}
 
     # -- state -------------------------------------------------------------------------------------
-    def commit(self) -> None:
-        """The step converged: what the springs still hold is dissipated, the anchors start from here."""
-        for s in self.stabilisers:
-            s.reanchor()
-
     def checkpoint(self):
         return [(s.anchor.copy(), s.work, s.updates, s.peak, s.last_force, s.previous) for s in self.stabilisers]
 
@@ -310,10 +330,11 @@ class Stabilisation(Contribution):
             s.work, s.updates, s.peak, s.last_force, s.previous = work, updates, peak, last, previous
 
     def state_arrays(self) -> dict:
-        """The dissipated work and the springs of every stabilised part (the anchors are the
-        configuration itself when a file is written: after a step's commit)."""
+        """The anchors (node-ordered, as the configuration), the dissipated work and the springs of
+        every stabilised part, on every rank."""
         out = {}
         for i, s in enumerate(self.stabilisers):
+            out[f"{i}_anchor"] = s.anchor_array()
             out[f"{i}_work"] = np.array([s.work])
             out[f"{i}_stiffness"] = s.k.copy()
         return out
@@ -326,7 +347,7 @@ class Stabilisation(Contribution):
                                  f"node, the part has {len(s.k)}")
             s.k = k.copy()
             s.work = float(arrays[f"{i}_work"][0])
-            s.anchor = s.values()
+            s.set_anchor_array(arrays[f"{i}_anchor"])
 
     def describe(self) -> dict:
         return {"name": self.name, "parts": [s.describe() for s in self.stabilisers]}

@@ -168,6 +168,18 @@ def test_stabilised_block_equals_the_unstabilised_one_once_contact_is_closed():
     assert errors["viscous"] > 1e3 * errors["closed"], errors  # the re-anchoring is what removes them
 
 
+def test_stabilised_block_under_arc_length():
+    """Arc-length from a closed contact: every step ends in equilibrium with the springs released
+    (base reaction λ·P, the springs' force below the solver's tolerance)."""
+    sc, _, _ = _blocks(0.0, stabilise=True)
+    res = dc.solve(sc, dc.ArcLength(initial_increment=0.25, max_load_factor=1.0, max_steps=10))
+    h = res.history
+    lam = h.column("load_factor")
+    assert lam[-1] >= 1.0 and h.column("cuts").sum() == 0
+    np.testing.assert_allclose(h.column("base_Fy"), lam * P, rtol=1e-8)
+    assert h.column("stab_force").max() < 1e-9 and h.column("stab_updates").min() >= 1
+
+
 @pytest.mark.skipif(comm.size > 1, reason="dense finite differences of the assembled system: serial")
 @pytest.mark.parametrize("kind", ["beam", "solid"])
 def test_stabilisation_tangent_matches_finite_differences(kind):

@@ -32,6 +32,7 @@ from .parts.base import finite_vector
 from .parts.groups import chain_coordinate
 from .result import Profile
 from .sections import Section
+from .stabilisation import Stabilisation, Stabiliser
 
 KINEMATICS = ("bernoulli", "timoshenko")
 
@@ -85,6 +86,7 @@ class Scene:
         self._loads = 0
         self._prescribed = 0
         self.interfaces: list = []
+        self.stabilisers: list[Stabiliser] = []
 
     # -- parts -----------------------------------------------------------------
     def _model(self, tmesh: TaggedMesh, solid_degree: int | None = None) -> Part:
@@ -303,6 +305,30 @@ class Scene:
         self.interfaces += made
         return ContactPair(made)
 
+    def stabilise(self, part: PartRef, stiffness: float | None = None, where: str | None = None, *,
+                  rotational_stiffness: float | None = None, factor: float = 1e-6, tolerance: float = 1e-9,
+                  max_updates: int = 20) -> Stabiliser:
+        """Weak springs to ground on the nodes of ``part`` (of its group ``where``, if given) for a body
+        that is free until contact closes (a lining in a larger hole, a block above its support, a
+        frictionless ring that may spin): k (u − a) on the translations (and the planar rotations of
+        2D structures) with the anchor a where they were last released; after each converged
+        solve the anchors follow the body and the solve is repeated while the springs
+        carry more than ``tolerance`` times the load (at most ``max_updates`` times a step), so
+        the converged answer is that without springs once the body is held
+        (:mod:`dolfinx_corot.stabilisation`).
+
+        stiffness: spring per node and translational dof (force per length); None: ``factor``
+        times the mean diagonal entry of the part's own tangent. rotational_stiffness: likewise
+        per planar rotation (moment per radian; 0: none). The work the springs absorb and their
+        force relative to the load are the history columns ``stab_work``, ``stab_force``
+        (end of step), ``stab_peak`` and ``stab_updates``."""
+        if any(s.part == part and s.where == where for s in self.stabilisers):
+            raise ValueError(f"stabilise: {part.kind} '{part.name or 'all cells'}'"
+                             f"{'' if where is None else f' at {where!r}'} is stabilised already")
+        made = Stabiliser(part, stiffness, where, rotational_stiffness, factor, tolerance, max_updates)
+        self.stabilisers.append(made)
+        return made
+
     def monitor(self, name: str, part: PartRef, where: str, reduce: str | None = None, along=None) -> None:
         """Record the dofs of the nodes of group ``where`` after every step.
 
@@ -387,9 +413,12 @@ class Scene:
         return self._coupled
 
     def contributions(self) -> list:
-        """The contributions the scene adds to its parts' system (contact, when it has interfaces):
-        a scene without them pays nothing for them."""
-        return [Contact(self.interfaces)] if self.interfaces else []
+        """The contributions the scene adds to its parts' system (contact, when it has interfaces;
+        the stabilisation, when a part is stabilised): a scene without them pays nothing for them."""
+        out = [Contact(self.interfaces)] if self.interfaces else []
+        if self.stabilisers:
+            out.append(Stabilisation(self.stabilisers))
+        return out
 
     def effects(self) -> list[str]:
         """What will be assembled, in words."""
@@ -404,13 +433,17 @@ class Scene:
             surface = "smooth master curve" if itf.smooth else "straight master segments"
             out.append(f"contact {itf.name}: {d['slave_nodes']} slave nodes on {d['master_segments']} "
                        f"segments ({kind}, penalty {itf.penalty:.3g}, {surface})")
+        out += [s.effect() for s in self.stabilisers]
         return out
 
     def describe(self) -> dict:
         """What defines the scene (its fingerprint's content): parts with mesh sizes, a hash of the
-        node coordinates, groups and materials; the contact interfaces."""
-        return {"large_rotations": self.large_rotations, "parts": [m.describe() for m in self._models.values()],
-                "interfaces": [itf.describe() for itf in self.interfaces]}
+        node coordinates, groups and materials; the contact interfaces; the stabilised parts."""
+        out = {"large_rotations": self.large_rotations, "parts": [m.describe() for m in self._models.values()],
+               "interfaces": [itf.describe() for itf in self.interfaces]}
+        if self.stabilisers:
+            out["stabilisation"] = [s.describe() for s in self.stabilisers]
+        return out
 
     def monitor_values(self, system) -> dict[str, float]:
         """Monitored dofs (one node, or a reduction over a group) and reactions at the current state

@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
 DEMO_DIR = ROOT / "demos"
 DEMOS = sorted(p.stem for p in DEMO_DIR.glob("*.py"))
 MPI_DEMOS = ["euler_beam_2d", "cantilever_rollup_2d", "lee_frame", "curved_beam_3d", "rollup_3d", "truss_dome_3d",
-             "strip_rollup", "cylinder_pullout", "hinged_sphere", "slit_annular_plate", "stiffened_strip", "euler_continuum_2d", "euler_continuum_3d", "hertz_2d", "contact_patch_test", "two_wheels", "beam_on_soil_2d"]
+             "strip_rollup", "cylinder_pullout", "hinged_sphere", "slit_annular_plate", "stiffened_strip", "euler_continuum_2d", "euler_continuum_3d", "hertz_2d", "contact_patch_test", "two_wheels", "beam_on_soil_2d", "lining_in_gap"]
 
 
 def _run(cmd, outdir, timeout=900):
@@ -147,7 +147,7 @@ def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
                 "no:cacheprovider", "--color=no", "tests/test_coupled.py", "tests/test_membrane_quad.py",
                 "tests/test_continuum.py", "tests/test_contact.py", "tests/test_contact_pressure.py", "tests/test_restart.py",
                 "tests/test_fields.py", "tests/test_reference.py", "tests/test_bad_input.py", "tests/test_monitors.py",
-                "tests/test_self_weight.py", "tests/test_cell_checks.py"],
+                "tests/test_self_weight.py", "tests/test_cell_checks.py", "tests/test_stabilisation.py"],
                tmp_path)
     summaries = [line for line in out.splitlines() if " passed" in line and line.rstrip().endswith("s")]
     assert len(summaries) == 2, out[-3000:]

@@ -85,6 +85,17 @@ def near_nullspace(comm, imap, block_size: int, modes: Sequence[np.ndarray]) -> 
     return PETSc.NullSpace().create(vectors=vecs, comm=comm)
 
 
+def form_diagonal(a) -> np.ndarray:
+    """The owned diagonal entries of the matrix of bilinear form ``a`` (no boundary conditions),
+    unrolled by blocks: a stiffness scale per dof."""
+    A = dolfinx.fem.petsc.assemble_matrix(a)
+    A.assemble()
+    diagonal = A.getDiagonal()
+    values = diagonal.array.copy()
+    destroy(diagonal, A)
+    return values
+
+
 def destroy(*objects) -> None:
     for obj in objects:
         if obj is not None:

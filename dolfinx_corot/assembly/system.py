@@ -359,16 +359,18 @@ class System:
 
     # -- Newton hooks, relayed to the contributions ---------------------------------
     def before_step(self) -> None:
+        """A load step (or its retry) starts: the contributions' hook, and the sum of its corrections
+        from 0 (see :meth:`step_increment_norm`)."""
         for c in self.contributions:
             c.before_step()
-
-    def begin_step(self) -> None:
-        """A Newton solve starts: the contributions' hook, and the sum of its corrections from 0
-        (see :meth:`step_increment_norm`)."""
-        for c in self.contributions:
-            c.before_solve()
         with self.step_dx.localForm() as s:
             s.set(0.0)
+
+    def begin_step(self) -> None:
+        """A Newton solve starts (the step's first, or one after a contribution's update at the
+        converged load factor): the contributions' hook."""
+        for c in self.contributions:
+            c.before_solve()
 
     def correction_rhs(self) -> PETSc.Vec:
         """The right-hand side of the next correction: b, less the forces the contributions ask
@@ -417,7 +419,9 @@ class System:
 
     # -- state ----------------------------------------------------------------------
     def step_increment_norm(self) -> float:
-        """‖Σ corrections‖ since :meth:`begin_step`."""
+        """‖Σ corrections‖ since :meth:`before_step`: the load step's increment, over all its Newton
+        solves (Newton's ``xtol`` is relative to it; a solve after a contribution's update at the
+        converged load factor may move the configuration by little)."""
         return self.step_dx.norm()
 
     def extrapolate(self, older, newer, factor: float) -> None:

@@ -89,3 +89,71 @@ def cylinder_eighth(radius: float, length: float, n_theta: int, n_x: int,
     finally:
         if comm.rank == 0:
             gmsh.finalize()
+
+
+def block_with_hole(width: float, height: float, depth: float, radius: float, size: float,
+                    hole_segments: int, comm: MPI.Comm = MPI.COMM_WORLD) -> TaggedMesh:
+    """A ground block [−width/2, width/2] × [−height, 0] with a circular hole of ``radius`` whose
+    centre lies ``depth`` below the surface, meshed with linear triangles of about ``size``
+    (``hole_segments`` equal segments on the hole). Groups: 'soil' (cells), 'cavity' (the hole's
+    boundary), 'base' (y = −height), 'sides' (x = ±width/2), 'top' (y = 0)."""
+    import gmsh
+
+    if not (0.0 < radius < depth < height and 2.0 * radius < width):
+        raise ValueError(f"block_with_hole: the hole (radius {radius}, centre {depth} deep) must lie inside the "
+                         f"block {width} × {height}")
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        occ = gmsh.model.occ
+        block = occ.addRectangle(-width / 2, -height, 0.0, width, height)
+        hole = occ.addDisk(0.0, -depth, 0.0, radius, radius)
+        (cut, _) = occ.cut([(2, block)], [(2, hole)])
+        occ.synchronize()
+        surface = cut[0][1]
+        groups = {"cavity": [], "base": [], "sides": [], "top": []}
+        for _, curve in gmsh.model.getBoundary(cut, oriented=False):
+            x0, y0, _, x1, y1, _ = gmsh.model.getBoundingBox(1, curve)
+            tol = 1e-6 * max(width, height)  # OCC pads bounding boxes
+            if abs(y0 + height) < tol and abs(y1 + height) < tol:
+                groups["base"].append(curve)
+            elif abs(y0) < tol and abs(y1) < tol:
+                groups["top"].append(curve)
+            elif abs(abs(x0) - width / 2) < tol and abs(x1 - x0) < tol:
+                groups["sides"].append(curve)
+            else:
+                groups["cavity"].append(curve)
+        gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
+        for curve in groups["cavity"]:
+            gmsh.model.mesh.setTransfiniteCurve(curve, int(hole_segments) + 1)
+        gmsh.model.addPhysicalGroup(2, [surface], 1)
+        gmsh.model.setPhysicalName(2, 1, "soil")
+        for k, (name, curves) in enumerate(groups.items()):
+            gmsh.model.addPhysicalGroup(1, curves, 2 + k)
+            gmsh.model.setPhysicalName(1, 2 + k, name)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+        gmsh.model.mesh.generate(2)
+    try:
+        return from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
+    finally:
+        if comm.rank == 0:
+            gmsh.finalize()
+
+
+def ring(radius: float, elements: int, centre=(0.0, 0.0), name: str = "ring",
+         comm: MPI.Comm = MPI.COMM_WORLD) -> TaggedMesh:
+    """A closed circle of ``elements`` straight 2D line elements through nodes on ``radius`` about
+    ``centre`` (a tunnel lining, a pipe). Groups: ``name`` (cells) and the nodes 'crown' (top),
+    'invert' (bottom) and 'springline' (the right end of the horizontal diameter); ``elements``
+    must be a multiple of 4."""
+    from .mesh import from_arrays
+
+    if elements < 4 or elements % 4:
+        raise ValueError(f"ring: elements = {elements} must be a multiple of 4 (nodes at crown, invert and "
+                         "springlines)")
+    t = np.arange(elements) * 2.0 * np.pi / elements
+    x = np.column_stack([centre[0] + radius * np.cos(t), centre[1] + radius * np.sin(t)])
+    cells = np.column_stack([np.arange(elements), (np.arange(elements) + 1) % elements])
+    q = elements // 4
+    return from_arrays(x, cells, name, point_groups={"springline": np.array([0]), "crown": np.array([q]),
+                                                      "invert": np.array([3 * q])}, comm=comm)

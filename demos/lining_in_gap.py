@@ -10,7 +10,8 @@
 # # A tunnel lining in a larger hole: stabilisation until contact closes
 #
 # A circular lining — a ring of 2D beams standing for a 1 m wide concrete
-# strip, axis radius 3 m, thickness 0.3 m, E = 30 GPa, weight 25 kN/m³ — lies
+# strip in plane strain (E/(1 − ν²)), axis radius 3 m, thickness 0.3 m,
+# E = 30 GPa, ν = 0.2, weight 25 kN/m³ (`scene.gravity` on the beams) — lies
 # in a hole of a soil block whose radius is 5 mm larger than the lining's
 # outer face. The soil (St Venant–Kirchhoff, E = 50 MPa, ν = 0.3, weight
 # 19.6 kN/m³; block 30 m × 25 m, hole centre 10 m deep, base clamped, sides
@@ -42,14 +43,14 @@
 #
 # Measured (8 steps, factor 10⁻⁶): the lining's centroid settles by 9.34 cm
 # (it follows the soil under gravity and the surcharge; crown and invert
-# nodes by 10.45 and 8.18 cm) and the ground ovalises it by 2.25 cm; 7–11
-# Newton iterations per step, 2–4 re-anchorings, 1 s; the springs' work is
+# nodes by 10.43 and 8.20 cm) and the ground ovalises it by 2.21 cm; 78
+# Newton iterations in all, 24 re-anchorings, 0.5 s; the springs' work is
 # 6·10⁻⁴ of the external work. Factor 10⁻⁵: the same answer to six digits,
-# 99 iterations, work 5·10⁻³. A frictionless lining has no stiffness against
+# 98 iterations, work 5·10⁻³. A frictionless lining has no stiffness against
 # spin, and the discretised contact (32 lining nodes on 48 cavity segments)
 # drives it by a small torque: with factor 10⁻⁶ the springs hold it with a
 # force of 2·10⁻⁶ of the load at most (reported as `stab_force`; the lining
-# turns by 1.5·10⁻⁴ rad); with factor 10⁻⁷ they let it roll by 1.9° into
+# turns by 1.4·10⁻⁴ rad); with factor 10⁻⁷ they let it roll by 1.9° into
 # another equilibrium of the frictionless model — settlement and
 # ovalisation within 0.2 % of the others. Friction, or a fixed point of the
 # lining, would hold the spin. Gaps are closed under load control: under
@@ -74,7 +75,8 @@ R_HOLE = R_AXIS + T / 2 + GAP
 WIDTH, HEIGHT, SEGMENTS, N_RING = 30.0, 25.0, 48, 32
 E_SOIL, NU_SOIL, RHO_SOIL, GRAVITY = 50e6, 0.3, 2000.0, 9.81
 E_LINING, NU_LINING, GAMMA_LINING, Q = 30e9, 0.2, 25e3, 100e3
-W_LINING = GAMMA_LINING * T * 2.0 * np.pi * R_AXIS
+# the lining's weight: γ t times the length of its axis, the 32-gon of the mesh's straight elements
+W_LINING = GAMMA_LINING * T * N_RING * 2.0 * R_AXIS * np.sin(np.pi / N_RING)
 # the soil's area: the block less the 48-gon of the hole (the mesh's straight segments)
 W_SOIL = RHO_SOIL * GRAVITY * (WIDTH * HEIGHT - 0.5 * SEGMENTS * R_HOLE**2 * np.sin(2 * np.pi / SEGMENTS))
 SELF_WEIGHT = dc.Amplitude(((0.0, 0.0), (1.0, 1.0)))
@@ -248,8 +250,9 @@ def main() -> dict:
                    h.column("base_Fy")[-1] / total, 1.0, rtol=1e-7,
                    reference="global equilibrium (hand calculation): the springs carry nothing")
         demo.check(f"factor {factor:.0e}: vertical contact force on the lining / its weight",
-                   run["contact"][1] / W_LINING, 1.0, rtol=1e-5,
-                   reference="equilibrium of the lining (hand calculation)")
+                   run["contact"][1] / W_LINING, 1.0, rtol=5e-5,
+                   reference="equilibrium of the lining (hand calculation); the rest, ~1e-5, is what the springs "
+                   "still hold against the frictionless lining's spin")
         demo.check(f"factor {factor:.0e}: springs' work / external work", h.column("stab_work")[-1] / run["external_work"],
                    bound=1e-2, reference="stabilisation acceptance: 1 % (ours)")
         demo.check(f"factor {factor:.0e}: largest spring force at a step's end / load", h.column("stab_force").max(),

@@ -397,7 +397,7 @@ class Scene:
             raise TypeError(f"monitor_contact '{name}': give what scene.contact returned, got {type(pair).__name__}")
         if not any(pair.interfaces[0] is itf for itf in self.interfaces):
             raise ValueError(f"monitor_contact '{name}': contact '{pair.name}' belongs to another scene")
-        pair._side(on)
+        pair.on_slaves(on)  # fails early for a side other than 'slaves' or 'masters'
         self._add_monitor(Monitor(name, pair, on, "contact"))
 
     # -- introspection -----------------------------------------------------------

@@ -431,11 +431,18 @@ class Interface:
         x = self._positions(self.slave)
         return x, out * self.area / _tributary_lengths(x, self.slave.facets)
 
+    @property
+    def contact_forces(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The pairs in contact at the last evaluation, this rank's: slave nodes (k,), their
+        master segments (k,) and the contact shares of the internal forces (k, 10): slave node
+        (x, y), then the four nodes of the segment's Hermite stencil."""
+        return self._forces
+
     def master_pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Contact pressure on the master side of this pass: the contact forces on each master node
         over its tributary length of the master surface (n_master,), with the nodes' coordinates
         (n_master, 2), on every rank (see :meth:`pressure` for the interface pressure)."""
-        s, m, f = self._forces
+        s, m, f = self.contact_forces
         seg = self.master.facets
         force = np.zeros((len(self.master.X), 2))
         for j in range(4):

@@ -106,7 +106,8 @@ class ContactPair:
     def __repr__(self) -> str:
         return f"ContactPair('{self.name}', {'two' if len(self) == 2 else 'one'}-pass)"
 
-    def _side(self, on: str):
+    def on_slaves(self, on: str) -> bool:
+        """Whether side ``on`` ('slaves' or 'masters') is the surface given as slaves."""
         if on not in self.SIDES:
             raise ValueError(f"contact '{self.name}': on = {on!r} must be one of {self.SIDES} (the surface "
                              "given as slaves or as masters to Scene.contact)")
@@ -120,12 +121,12 @@ class ContactPair:
         current: the true pressure, force per current face length, with the current face
         positions; False (default): the nominal pressure, force per reference face length, with
         the reference positions. See the module documentation for the formulae."""
-        slaves_side = self._side(on)
+        slaves_side = self.on_slaves(on)
         first = self.interfaces[0]
         surf = first.slave if slaves_side else first.master
         internal = np.zeros((len(surf.keys), 2))
         for k, itf in enumerate(self.interfaces):
-            s, m, f = itf._forces
+            s, m, f = itf.contact_forces
             if (k == 0) == slaves_side:  # this side holds the pass's slave nodes
                 np.add.at(internal, s, f[:, 0:2])
             else:

@@ -144,7 +144,7 @@ def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
     out = _run(["mpirun", "-n", "2", "sh", "-c", per_rank, "sh", sys.executable, "-m", "pytest", "-q", "-p",
                 "no:cacheprovider", "--color=no", "tests/test_coupled.py", "tests/test_membrane_quad.py",
                 "tests/test_continuum.py", "tests/test_contact.py", "tests/test_restart.py", "tests/test_fields.py",
-                "tests/test_reference.py", "tests/test_bad_input.py"],
+                "tests/test_reference.py", "tests/test_bad_input.py", "tests/test_stability.py"],
                tmp_path)
     summaries = [line for line in out.splitlines() if " passed" in line and line.rstrip().endswith("s")]
     assert len(summaries) == 2, out[-3000:]

@@ -108,6 +108,8 @@ class System:
                                       "(linear_solver='direct' or 'auto')")
         for c in self.contributions:
             c.bind(self)
+        self._version = 0          # counts changes of the configuration
+        self._tangent_version = -1  # the configuration of a tangent assembled ahead (tangent_at)
         self.C: PETSc.Mat | None = None   # the contributions' matrix over their declared couplings
         self._merged = False
         self.pattern_builds = 0
@@ -205,6 +207,7 @@ class System:
 
     def set_global_arrays(self, arrays: dict) -> None:
         """Restore configuration and contribution states from :meth:`global_arrays`' output."""
+        self._version += 1
         for i, m in enumerate(self.models):
             m.state.x.array[:] = m.from_global(arrays[f"state{i}"])
         for i, c in enumerate(self.contributions):
@@ -248,7 +251,11 @@ class System:
 
     def jacobian(self) -> None:
         """Assemble the tangent K = ∂f_int/∂x (parts and contributions), identity rows/columns on
-        supports."""
+        supports; a tangent that :meth:`tangent_at` assembled at this very configuration is kept
+        (parts alone: it depends on the configuration only)."""
+        if self._tangent_version == self._version and self.tangent_reusable:
+            self._tangent_version = -1
+            return
         t = time.perf_counter()
         self._assemble_parts_matrix()
         self._add_contribution_tangents()
@@ -325,6 +332,64 @@ class System:
     def negative_eigenvalues(self) -> int | None:
         return self.linear.negative_eigenvalues()
 
+    # -- stability of the tangent -----------------------------------------------------
+    @property
+    def counts_inertia(self) -> bool:
+        """Whether every factorization of the Newton solver counts negative eigenvalues (LDLᵀ)."""
+        return self.linear.ldlt
+
+    def take_inertia(self) -> tuple[list[int], list[int]]:
+        """(negative-eigenvalue counts, determinant signs) of the tangents factorized since the
+        last call (LDLᵀ gives counts, LU signs)."""
+        return self.linear.take_inertia()
+
+    @property
+    def tangent_reusable(self) -> bool:
+        # contributions may change their pairs when a solve begins; prescribed motion of coupled
+        # parts is lifted while the tangent is constrained
+        return not self.contributions and not (self.model.coupled and self.has_prescribed_motion)
+
+    def tangent_at(self, load_factor: float, factorize: bool = True) -> None:
+        """Assemble (and, with a direct solver, factorize) the tangent at the current configuration,
+        its contributions evaluated there; the next Newton solve from here uses it as it is."""
+        self._tangent_version = -1
+        self.residual(load_factor)
+        self.jacobian()
+        self._tangent_version = self._version
+        if factorize:
+            t = time.perf_counter()
+            self.linear.factorize()
+            self.timings.solve += time.perf_counter() - t
+
+    def inertia(self) -> int:
+        """Negative eigenvalues of the symmetric part of the last assembled tangent (an LDLᵀ
+        factorization of its own; −1: singular)."""
+        t = time.perf_counter()
+        try:
+            return self.linear.inertia()
+        finally:
+            self.timings.solve += time.perf_counter() - t
+
+    def smallest_eigenvalue(self) -> float:
+        """Eigenvalue closest to zero of the (symmetric part of the) last assembled tangent, the
+        constrained dofs taken out."""
+        return self.linear.smallest_eigenvalue(self.constrained_global_dofs())
+
+    def softest_motions(self, count: int) -> tuple[list, list[float]]:
+        """The ``count`` softest motions of the last assembled tangent (its null space if singular),
+        orthonormal, softest first, and their quotients ‖K v‖/max|diag K|."""
+        vectors = [self.new_vector() for _ in range(count)]
+        q = self.linear.null_space(self.constrained_global_dofs(), vectors)
+        for v in vectors:
+            v.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        return vectors, q
+
+    def set_model_array(self, model, values: np.ndarray, vec: PETSc.Vec) -> None:
+        """vec = ``values`` (local array in the layout of ``model.V``) on the model's dofs, 0 elsewhere."""
+        with vec.localForm() as f:
+            f.set(0.0)
+            f.array[:] = values
+
     @property
     def krylov_iterations(self) -> int:
         return self.linear.krylov_iterations
@@ -345,6 +410,7 @@ class System:
     def update(self, scale: float = 1.0) -> None:
         """x ← x ⊕ scale·dx through the model's update rule (multiplicative for rotations)."""
         t = time.perf_counter()
+        self._version += 1
         if scale != 1.0:
             self.dx.scale(scale)
         self.model.update(self.dx)
@@ -423,6 +489,7 @@ class System:
     def extrapolate(self, older, newer, factor: float) -> None:
         """Set x to newer ⊕ factor·(newer ⊖ older) (a secant predictor; configurations of
         :meth:`checkpoint`)."""
+        self._version += 1
         self.model.extrapolate(older[0], newer[0], factor)
 
     def checkpoint(self):
@@ -430,6 +497,7 @@ class System:
         return (self.model.checkpoint(), [c.checkpoint() for c in self.contributions])
 
     def restore(self, cp) -> None:
+        self._version += 1
         self.model.restore(cp[0])
         for c, state in zip(self.contributions, cp[1]):
             c.restore(state)
@@ -506,6 +574,11 @@ class CoupledSystem(System):
         vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         with vec.localForm() as f:
             return f.array[self.layout.local[i]].copy()
+
+    def set_model_array(self, model, values: np.ndarray, vec: PETSc.Vec) -> None:
+        with vec.localForm() as f:
+            f.set(0.0)
+            f.array[self.layout.local[self.model.models.index(model)]] = values
 
     def _owned_indicator(self, arrays: Sequence[np.ndarray]) -> np.ndarray:
         """Owned entries of Σ models' local arrays (a reduction over ranks)."""
@@ -599,6 +672,7 @@ class CoupledSystem(System):
 
     def update(self, scale: float = 1.0) -> None:
         t = time.perf_counter()
+        self._version += 1
         self.dx.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         with self.dx.localForm() as f:
             dxl = f.array

@@ -52,7 +52,9 @@ class NewtonOptions:
     final tolerance needs; direct solvers ignore it;
     preconditioner: 'step' builds the iterative solver's preconditioner (AMG) from the first
     tangent of each step and keeps it for the step's later iterations, 'iteration' rebuilds it
-    every iteration."""
+    every iteration;
+    max_displacement: a converged state whose displacement exceeds this many times the model's
+    size is absurd (loads or materials in the wrong units), and the run stops there."""
 
     rtol: float = 1e-9
     atol: float = 0.0
@@ -68,6 +70,7 @@ class NewtonOptions:
     forcing_max: float = 1e-2
     forcing_gamma: float = 0.9
     preconditioner: str = "step"
+    max_displacement: float = 1e3
 
     def __post_init__(self):
         for name in ("rtol", "atol", "xtol"):
@@ -78,6 +81,7 @@ class NewtonOptions:
         validate.whole("NewtonOptions", "max_growth", self.max_growth, 1)
         validate.whole("NewtonOptions", "line_search_trials", self.line_search_trials, 0)
         validate.positive("NewtonOptions", "divergence_factor", self.divergence_factor)
+        validate.positive("NewtonOptions", "max_displacement", self.max_displacement)
         if self.preconditioner not in ("step", "iteration"):
             raise ValueError(f"NewtonOptions: preconditioner = {self.preconditioner!r} is not 'step' or "
                              "'iteration'")
@@ -92,6 +96,7 @@ class NewtonReport:
     reason: str = ""
     updates: int = 0  # contributions' state updates after convergence (augmented-Lagrangian: Uzawa)
     load_factor: float = math.nan  # where the solve ended
+    singular_start: bool = False  # the first tangent of the solve could not be factorized
 
     def rate(self) -> float:
         """Estimated order of convergence from the last three residuals (nan if too few)."""
@@ -170,6 +175,7 @@ def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin:
             report.increments.append(stepper.correct(system, system.correction_rhs()))
         except np.linalg.LinAlgError as err:
             report.reason = str(err)
+            report.singular_start = it == 1
             break
         factor = system.limit_correction()  # e.g. contact nodes move at most a search margin
         if factor < 1.0:
@@ -221,6 +227,7 @@ def solve_step(system, stepper, options: NewtonOptions, begin: bool = True) -> N
         again.updates = report.updates + 1
         again.iterations += report.iterations
         again.residuals = report.residuals + again.residuals
+        again.singular_start = False
         report = again
     if not report.converged and report.updates:
         report.reason = f"after {report.updates} contribution update(s): {report.reason}"

@@ -158,6 +158,10 @@ class LoadControl:
                                  "Try smaller steps, or arc-length past a limit point.")
                     continue
                 before, after, passed = tracker.converged(trial)
+                if passed and after == before:
+                    passed = tracker.secant_unstable(cp, system.checkpoint(), lam, trial, before)
+                    if not passed:
+                        tracker.count_here(trial)  # the next step's first tangent again
                 extra = {} if after is None else {"negative_eigenvalues": after}
                 if before is not None and after is not None and (after != before or passed):
                     self._critical_point(run, tracker, cp, previous, lam, trial, before, after, passed)

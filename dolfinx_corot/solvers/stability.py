@@ -370,6 +370,34 @@ class StabilityTracker:
         self.negative = after
         return before, after, passed
 
+    def count_here(self, load_factor: float) -> int:
+        """Negative eigenvalues of the tangent at the current configuration."""
+        self.system.take_inertia()
+        if self.free:
+            self.system.tangent_at(load_factor)
+            counts, _ = self.system.take_inertia()
+            return counts[-1] if counts else -1
+        self.system.tangent_at(load_factor, factorize=False)
+        return self.system.inertia()
+
+    def secant_unstable(self, older, newer, lam0: float, lam1: float, before: int) -> bool:
+        """Whether states on the secant between two converged states (configurations ``older``
+        and ``newer``) have more negative eigenvalues than ``before``: the step crossed an
+        unstable region (snap-through), rather than Newton's iterates merely overshooting."""
+        system = self.system
+        unstable = False
+        for t in (0.25, 0.5, 0.75):
+            system.restore(newer)
+            try:
+                system.extrapolate(older, newer, -(1.0 - t))
+            except NotImplementedError:  # no secant between rotations in 3D
+                break
+            if self.count_here(lam0 + t * (lam1 - lam0)) > before:
+                unstable = True
+                break
+        system.restore(newer)
+        return unstable
+
     def eigenvalue_here(self, load_factor: float) -> float:
         self.system.tangent_at(load_factor)
         return self.system.smallest_eigenvalue()

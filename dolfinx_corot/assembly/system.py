@@ -17,6 +17,7 @@ homogeneous on supported dofs. The system knows nothing about beams or contact.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from dataclasses import dataclass
 from typing import Protocol, Sequence
@@ -123,6 +124,7 @@ class System:
                                              model.near_nullspace_modes())
         self.linear = petsc.LinearSolver(self.comm, self.A, self.iterative, symmetric, options_prefix, nullspace,
                                          fixed_rtol=not model.large_rotations)
+        self._fields_setup()
 
     # -- layout (one mesh: DOLFINx's own) -------------------------------------------
     def _build(self) -> None:
@@ -236,13 +238,84 @@ class System:
         self.fext_total.scale(load_factor)
         for amp, v in self.amplitude_loads:
             self.fext_total.axpy(amp(load_factor), v)
-        ref = max(self.fext_total.norm(), self.fint.norm())
         self.fext_total.copy(self.b)
         self.b.axpy(-1.0, self.fint)
         self._constrain_residual(load_factor)
-        norm = self.b.norm()
+        rot = self._rot
+        squares = np.zeros(6)
+        for k, v in enumerate((self.b, self.fext_total, self.fint)):
+            a = v.array
+            squares[2 * k] = a[~rot] @ a[~rot]
+            squares[2 * k + 1] = a[rot] @ a[rot]
+        squares = self.comm.allreduce(squares, op=MPI.SUM)
+        norm = math.sqrt(squares[0] + squares[1])
+        ref = max(math.sqrt(squares[2] + squares[3]), math.sqrt(squares[4] + squares[5]))
+        # per field (forces; moments on rotational dofs), each against its own scale
+        ref_f = max(math.sqrt(squares[2]), math.sqrt(squares[4]))
+        self.fields = {"force": (math.sqrt(squares[0]), ref_f)}
+        if self.has_rotations:
+            ref_m = max(math.sqrt(squares[3]), math.sqrt(squares[5]))
+            ell = self.length_scale
+            self.fields = {"force": (math.sqrt(squares[0]), max(ref_f, ref_m / ell if ell > 0.0 else 0.0)),
+                           "moment": (math.sqrt(squares[1]), max(ref_m, ell * ref_f))}
         self.timings.assembly += time.perf_counter() - t
         return norm, ref
+
+    # -- convergence measures: fields and the round-off floor -------------------------
+    def _rotation_mask(self) -> np.ndarray:
+        """Owned entries of the system's vectors that are rotations (True) or translations."""
+        m = self.model
+        mask = np.zeros((self.b.getLocalSize() // m.ndof, m.ndof), dtype=bool)
+        mask[:, m.translations:] = True
+        return mask.ravel()
+
+    def _fields_setup(self) -> None:
+        """Which dofs carry moments; the model's length and coordinate scales (round-off floor)."""
+        self._rot = self._rotation_mask()
+        self.has_rotations = bool(self.comm.allreduce(int(self._rot.any()), op=MPI.MAX))
+        lo, hi, big = [], [], 0.0
+        for m in self.models:
+            X = m.V.mesh.geometry.x[:, : m.gdim]
+            if len(X):
+                lo.append(X.min(axis=0))
+                hi.append(X.max(axis=0))
+                big = max(big, float(np.abs(X).max()))
+        gd = self.models[0].gdim
+        lo = self.comm.allreduce(np.min(lo, axis=0) if lo else np.full(gd, np.inf), op=MPI.MIN)
+        hi = self.comm.allreduce(np.max(hi, axis=0) if hi else np.full(gd, -np.inf), op=MPI.MAX)
+        self.length_scale = float(np.linalg.norm(hi - lo))
+        self.coordinate_scale = self.comm.allreduce(big, op=MPI.MAX)
+        self.floors = {"force": 0.0, "moment": 0.0}
+        self._diagonal = None
+
+    def _update_floor(self) -> None:
+        """The residual's round-off floor per field, from the tangent just assembled: an internal
+        force computed from coordinates of size c carries errors of about ε K_ii c on dof i
+        (ε K_ii on a rotation, angles of order one), so no residual below
+        ε ‖diag(K) c‖ can be told from zero."""
+        if self._diagonal is None:
+            self._diagonal = self.A.createVecLeft()
+        self.A.getDiagonal(self._diagonal)
+        d = np.abs(self._diagonal.array)
+        rot = self._rot
+        eps = np.finfo(float).eps
+        sq = self.comm.allreduce(np.array([(d[~rot] @ d[~rot]) * self.coordinate_scale**2, d[rot] @ d[rot]]),
+                                 op=MPI.SUM)
+        self.floors = {"force": eps * math.sqrt(sq[0]), "moment": eps * math.sqrt(sq[1])}
+
+    def correction_norms(self) -> dict[str, tuple[float, float]]:
+        """Per field: (‖dx‖, ‖Σ corrections of the step‖) — translations, rotations."""
+        rot = self._rot
+        sq = np.zeros(4)
+        for k, v in enumerate((self.dx, self.step_dx)):
+            a = v.array
+            sq[2 * k] = a[~rot] @ a[~rot]
+            sq[2 * k + 1] = a[rot] @ a[rot]
+        sq = np.sqrt(self.comm.allreduce(sq, op=MPI.SUM))
+        out = {"force": (sq[0], sq[2])}
+        if self.has_rotations:
+            out["moment"] = (sq[1], sq[3])
+        return out
 
     def _assemble_parts_matrix(self) -> None:
         self.A.zeroEntries()
@@ -260,6 +333,7 @@ class System:
         self._assemble_parts_matrix()
         self._add_contribution_tangents()
         self._constrain_matrix()
+        self._update_floor()
         self.linear.operator_changed()
         self.timings.assembly += time.perf_counter() - t
 
@@ -579,6 +653,14 @@ class CoupledSystem(System):
         with vec.localForm() as f:
             f.set(0.0)
             f.array[self.layout.local[self.model.models.index(model)]] = values
+
+    def _rotation_mask(self) -> np.ndarray:
+        arrays = []
+        for m, loc in zip(self.model.models, self.layout.local):
+            r = np.zeros((len(loc) // m.ndof, m.ndof))
+            r[:, m.translations:] = 1.0
+            arrays.append(r.ravel())
+        return self._owned_indicator(arrays) > 0
 
     def _owned_indicator(self, arrays: Sequence[np.ndarray]) -> np.ndarray:
         """Owned entries of Σ models' local arrays (a reduction over ranks)."""

@@ -28,6 +28,9 @@ from .stability import (CriticalPoint, CriticalPointError, StabilityTracker, che
                         singular_model)
 
 STABILITY = ("auto", "on", "off")
+# a step whose Newton iterates crossed states less stable than both its ends is cut and retried;
+# a leap across a limit point is declared when it persists at 1/2**LEAP_CUTS of the nominal step
+LEAP_CUTS = 4
 
 logger = logging.getLogger(__name__)
 
@@ -46,7 +49,8 @@ class LoadControl:
     ('auto': free with the LDLᵀ solver, one extra LDLᵀ factorization per step otherwise for
     systems of up to 200 000 dofs; 'on'; 'off'; see :mod:`~dolfinx_corot.solvers.stability`);
     at_critical_point: where the count changes (a bifurcation) or a step leaps across a limit
-    point, the critical point is recorded (``result.critical_points``, with its load factor) and
+    point (its Newton iterates cross states less stable than both ends, and still do when the
+    step is cut to 1/16), the critical point is recorded (``result.critical_points``, with its load factor) and
     'stop' (default) ends the run at the last state before it with a
     :class:`~dolfinx_corot.solvers.stability.CriticalPointError`; 'continue' goes on (with a
     warning): load control past a critical point follows an unstable or a remote branch.
@@ -153,11 +157,24 @@ class LoadControl:
                     run.cuts += 1
                     logger.info("step %d: lambda %.6g failed (%s); cut %d", run.step + 1, trial, report.reason, cuts)
                     if cuts > self.max_cuts:
+                        if previous is not None and tracker.enabled:
+                            self._limit_ahead(run, tracker, previous, lam, target)
                         run.fail(f"step {run.step + 1}: no convergence to load factor {trial:.6g} from "
                                  f"{lam:.6g} after {self.max_cuts} cuts; last attempt: {report.reason}. "
                                  "Try smaller steps, or arc-length past a limit point.")
                     continue
                 before, after, passed = tracker.converged(trial)
+                if passed and after == before and cuts < self.max_cuts and \
+                        abs(trial - lam) > abs(target - (targets[index - 1] if index else 0.0)) / 2**LEAP_CUTS:
+                    # the iterates crossed less stable states than both ends: a leap across a limit
+                    # point, or an overshoot of Newton's first iterates; a shorter step tells
+                    system.restore(cp)
+                    tracker.negative = before
+                    cuts += 1
+                    run.cuts += 1
+                    logger.info("step %d: the iterates to lambda %.6g crossed states less stable than both ends; "
+                                "cut %d", run.step + 1, trial, cuts)
+                    continue
                 if passed and after == before:
                     passed = tracker.secant_unstable(cp, system.checkpoint(), lam, trial, before)
                     if not passed:
@@ -172,6 +189,30 @@ class LoadControl:
                 run.save({**self.describe(), "next_target": index + 1 if reached else index})
                 cuts = max(cuts - 1, 0)
         return run.result()
+
+    def _limit_ahead(self, run: Run, tracker: StabilityTracker, previous, lam: float, target: float) -> None:
+        """Load control could not go beyond λ = ``lam``: if the smallest eigenvalue μ of the tangent
+        falls towards zero there — μ² extrapolated from the last two converged states vanishes
+        before ``target`` — a limit point lies ahead; record it and stop with its estimate."""
+        system = run.system
+        here = system.checkpoint()
+        mu0 = tracker.eigenvalue_here(lam)
+        system.restore(previous[1])
+        mum = tracker.eigenvalue_here(previous[0])
+        system.restore(here)
+        if not (mum**2 > mu0**2 > 0.0 and abs(mu0) < abs(mum)):
+            return
+        estimate = lam + mu0**2 * (lam - previous[0]) / (mum**2 - mu0**2)
+        if not min(lam, target) <= estimate <= max(lam, target):
+            return
+        point = CriticalPoint("limit point", float(estimate), (float(lam), float(target)), run.step + 1,
+                              int(tracker.negative or 0), int(tracker.negative or 0),
+                              "squared smallest eigenvalue extrapolated to zero")
+        run.critical_points.append(point)
+        run.fail(f"step {run.step + 1}: a limit point near load factor {estimate:.6g}: load control cannot go "
+                 f"beyond {lam:.6g} (towards {target:.6g}), where the smallest eigenvalue of the tangent "
+                 f"falls to zero. Follow the path with ArcLength (or prescribe a displacement: displacement "
+                 "control).", CriticalPointError)
 
     def _critical_point(self, run: Run, tracker: StabilityTracker, cp, previous, lam: float, trial: float,
                         before: int, after: int, passed: bool) -> None:

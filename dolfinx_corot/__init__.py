@@ -21,10 +21,12 @@ from .parts import MeshError
 from .result import History, Result
 from .scene import Scene
 from .sections import Circle, Rectangle, Section
-from .solvers import ArcLength, CheckpointError, ConvergenceError, LoadControl, NewtonOptions, solve
+from .solvers import (ArcLength, CheckpointError, ConvergenceError, CriticalPoint, CriticalPointError, LoadControl,
+                      NewtonOptions, SingularModelError, solve)
 
 __version__ = "0.1.0"
 
-__all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "ContactPair", "Penalty", "Circle", "ConvergenceError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
+__all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "ContactPair", "Penalty", "Circle", "ConvergenceError", "CriticalPoint",
+           "CriticalPointError", "SingularModelError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
            "MeshError", "NeoHookean", "NewtonOptions", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
            "rotations", "solve"]

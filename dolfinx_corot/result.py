@@ -144,6 +144,7 @@ class Result:
     message: str = ""
     totals: dict = field(default_factory=dict)
     profiles: dict = field(default_factory=dict)
+    critical_points: list = field(default_factory=list)  # CriticalPoint: limit points, bifurcations
 
     def write(self, directory: str, name: str = "history") -> str:
         """Write ``<directory>/<name>.csv``, a JSON summary and, with profiles,
@@ -161,6 +162,7 @@ class Result:
             with open(os.path.join(directory, f"{name}_profiles.npz"), "wb") as f:
                 np.savez(f, **arrays)
         with open(os.path.join(directory, f"{name}_summary.json"), "w") as f:
+            summary["critical_points"] = [c.as_dict() for c in self.critical_points]
             json.dump(summary, f, indent=1)
         return path
 
@@ -172,6 +174,8 @@ def limit_load(load: np.ndarray, *coordinates: np.ndarray, kind: str = "max", fi
     load: (n,) load factors along the path (start at the unloaded state for a
     first maximum); coordinates: (n,) arrays, e.g. monitored displacements;
     kind: 'max' or 'min'; first: the first local extremum instead of the global one.
+    A path whose extremum is its first or last point has none inside it (the load still rises,
+    or falls, at its end): that is a ValueError, not a limit load.
     """
     lam = np.asarray(load, dtype=float)
     xs = np.array([np.asarray(c, dtype=float) for c in coordinates])
@@ -183,7 +187,10 @@ def limit_load(load: np.ndarray, *coordinates: np.ndarray, kind: str = "max", fi
     else:
         k = int(np.argmax(sign * lam))
     if k == 0 or k == len(lam) - 1:
-        return float(lam[k])
+        word = "maximum" if kind == "max" else "minimum"
+        raise ValueError(f"the path has no {word} of the load inside it: its {word} is at its "
+                         f"{'first' if k == 0 else 'last'} point (λ = {lam[k]:.6g}), so the load may go on "
+                         f"{'rising' if kind == 'max' else 'falling'}; follow the path further")
     s = np.concatenate([[0.0], np.cumsum(np.sqrt((np.diff(xs, axis=1) ** 2).sum(axis=0)))])
     c = np.polyfit(s[k - 1:k + 2], lam[k - 1:k + 2], 2)
     return float(c[2] - c[1] ** 2 / (4 * c[0]))

@@ -20,3 +20,9 @@ def positive(owner: str, name: str, value, allow_zero: bool = False, allow_none:
     if not ok:
         raise ValueError(f"{owner}: {name} = {value!r} must be a finite number "
                          f"{'≥ 0' if allow_zero else '> 0'}")
+
+
+def choice(owner: str, name: str, value, options) -> None:
+    """``value`` is one of ``options``, or a ValueError naming ``owner.name``."""
+    if value not in options:
+        raise ValueError(f"{owner}: {name} = {value!r} is not one of {tuple(options)}")

@@ -96,6 +96,16 @@ def form_diagonal(a) -> np.ndarray:
     return values
 
 
+def _orthonormalize(vectors: list) -> None:
+    """Modified Gram–Schmidt in place."""
+    for i, v in enumerate(vectors):
+        for w in vectors[:i]:
+            v.axpy(-v.dot(w), w)
+        n = v.norm()
+        if n > 0.0:
+            v.scale(1.0 / n)
+
+
 def destroy(*objects) -> None:
     for obj in objects:
         if obj is not None:
@@ -156,9 +166,17 @@ class LinearSolver:
             and pc.getFactorSolverType() == "mumps"
         self.ldlt = self.mumps and pc.getType() == "cholesky"
         if self.mumps:
-            # null-pivot detection (ICNTL 24): a singular tangent is reported, not solved
+            # null-pivot detection (ICNTL 24): a singular tangent is reported, not solved; LU also
+            # computes the determinant (ICNTL 33), whose sign is the parity of the number of
+            # negative real eigenvalues
             pc.setFactorSetUpSolverType()
             pc.getFactorMatrix().setMumpsIcntl(24, 1)
+            if not self.ldlt:
+                pc.getFactorMatrix().setMumpsIcntl(33, 1)
+        # per factorization since the last :meth:`take_inertia`: negative eigenvalues (LDLᵀ) or
+        # the sign of the determinant (LU: +1 even, −1 odd)
+        self._inertia: list[int] = []
+        self._signs: list[int] = []
 
     def operator_changed(self) -> None:
         """The tangent A was re-assembled: the AIJ copy that AMG smooths with follows it."""
@@ -187,7 +205,12 @@ class LinearSolver:
             raise np.linalg.LinAlgError(f"linear solve failed (PETSc reason {reason}); "
                                         "the tangent may be singular (a missing support?)")
         if self.mumps:
-            null_pivots = self.ksp.getPC().getFactorMatrix().getMumpsInfog(28)
+            F = self.ksp.getPC().getFactorMatrix()
+            null_pivots = F.getMumpsInfog(28)
+            if self.ldlt:
+                self._inertia.append(int(F.getMumpsInfog(12)))
+            elif null_pivots == 0:
+                self._signs.append(1 if F.getMumpsRinfog(12) >= 0.0 else -1)
             if null_pivots > 0:
                 raise np.linalg.LinAlgError(
                     f"the tangent stiffness is singular ({null_pivots} zero pivot(s)): a missing support "
@@ -221,6 +244,127 @@ class LinearSolver:
         if not self.ldlt:
             return None
         return int(self.ksp.getPC().getFactorMatrix().getMumpsInfog(12))
+
+    def factorize(self) -> None:
+        """Factorize the current tangent now (direct solvers; the next solve reuses it) and note
+        its inertia as a solve does."""
+        if not self.mumps:
+            return
+        self.ksp.setUp()
+        self.ksp.getPC().setUp()  # refactors when the matrix changed since the last set-up
+        F = self.ksp.getPC().getFactorMatrix()
+        if F.getMumpsInfog(28) > 0:
+            return
+        if self.ldlt:
+            self._inertia.append(int(F.getMumpsInfog(12)))
+        else:
+            self._signs.append(1 if F.getMumpsRinfog(12) >= 0.0 else -1)
+
+    def take_inertia(self) -> tuple[list[int], list[int]]:
+        """(negative-eigenvalue counts, determinant signs) of the factorizations since the last call."""
+        out = (self._inertia, self._signs)
+        self._inertia, self._signs = [], []
+        return out
+
+    def _symmetric_copy(self, scale_constrained: np.ndarray | None = None) -> PETSc.Mat:
+        """½(A + Aᵀ) as AIJ; the rows and columns ``scale_constrained`` (global) get the diagonal
+        max|diag A| instead of 1, so that supports do not pose as soft modes."""
+        A = self.A.convert("aij", PETSc.Mat()) if self._block else self.A
+        S = A.copy()
+        S.axpy(1.0, A.transpose(PETSc.Mat()), PETSc.Mat.Structure.DIFFERENT)
+        S.scale(0.5)
+        if scale_constrained is not None:
+            d = S.getDiagonal()
+            big = max(d.norm(PETSc.NormType.INFINITY), 1e-300)
+            d.destroy()
+            start, stop = S.getOwnershipRange()
+            rows = scale_constrained[(scale_constrained >= start) & (scale_constrained < stop)]
+            S.zeroRowsColumns(rows.astype(PETSc.IntType), big)
+        if A is not self.A:
+            A.destroy()
+        return S
+
+    def inertia(self) -> int:
+        """Number of negative eigenvalues of the symmetric part of the last assembled tangent, by an
+        LDLᵀ factorization of its own (for LU and iterative solvers, which do not count them);
+        −1 if that matrix is singular."""
+        S = self._symmetric_copy()
+        S.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        ksp = PETSc.KSP().create(self.comm)
+        ksp.setType("preonly")
+        ksp.getPC().setType("cholesky")
+        ksp.getPC().setFactorSolverType("mumps")
+        ksp.setOperators(S)
+        ksp.getPC().setFactorSetUpSolverType()
+        F = ksp.getPC().getFactorMatrix()
+        F.setMumpsIcntl(24, 1)
+        ksp.setUp()
+        F = ksp.getPC().getFactorMatrix()
+        count = -1 if F.getMumpsInfog(28) > 0 else int(F.getMumpsInfog(12))
+        destroy(ksp, S)
+        return count
+
+    def smallest_eigenvalue(self, constrained: np.ndarray) -> float:
+        """The eigenvalue closest to zero of the symmetric part of the last assembled tangent with
+        the constrained dofs taken out (SLEPc, shift-and-invert about 0)."""
+        from slepc4py import SLEPc
+
+        S = self._symmetric_copy(constrained)
+        eps = SLEPc.EPS().create(self.comm)
+        eps.setOperators(S)
+        eps.setProblemType(SLEPc.EPS.ProblemType.HEP)
+        eps.setDimensions(1)
+        eps.setTarget(0.0)
+        eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+        st = eps.getST()
+        st.setType("sinvert")
+        ksp = st.getKSP()
+        ksp.setType("preonly")
+        ksp.getPC().setType("lu")
+        ksp.getPC().setFactorSolverType("mumps")
+        eps.setTolerances(1e-10, 200)
+        eps.solve()
+        value = eps.getEigenvalue(0).real if eps.getConverged() > 0 else float("nan")
+        eps.destroy()
+        S.destroy()
+        return float(value)
+
+    def null_space(self, constrained: np.ndarray, vectors: list, iterations: int = 4) -> list[float]:
+        """The softest motions of the last assembled tangent (its null space when it is singular)
+        by subspace inverse iteration on K + σ·max|diag K| (σ = 1e-9), the constrained dofs taken
+        out: ``vectors`` (orthonormal on return, softest first); returns their Rayleigh
+        quotients ‖K v‖/max|diag K|."""
+        S = self._symmetric_copy(constrained)
+        d = S.getDiagonal()
+        big = max(d.norm(PETSc.NormType.INFINITY), 1e-300)
+        d.destroy()
+        K = S.copy()
+        S.shift(1e-9 * big)
+        ksp = PETSc.KSP().create(self.comm)
+        ksp.setType("preonly")
+        ksp.getPC().setType("lu")
+        ksp.getPC().setFactorSolverType("mumps")
+        ksp.setOperators(S)
+        start, stop = S.getOwnershipRange()
+        idx = np.arange(start, stop)
+        work = vectors[0].duplicate()
+        for k, v in enumerate(vectors):  # start vectors that every partition builds alike
+            v.array[:] = np.sin(idx * (0.37 + 0.61 * k) + k)
+        for _ in range(iterations):
+            for v in vectors:
+                v.copy(work)
+                ksp.solve(work, v)
+            _orthonormalize(vectors)
+        quotients = []
+        for v in vectors:
+            K.mult(v, work)
+            quotients.append(work.norm() / big)
+        order = np.argsort(quotients)
+        copies = [vectors[i].copy() for i in order]
+        for v, c in zip(vectors, copies):
+            c.copy(v)
+        destroy(ksp, S, K, work, *copies)
+        return [float(quotients[i]) for i in order]
 
     def destroy(self) -> None:
         destroy(self._fallback, self.P, self.ksp)

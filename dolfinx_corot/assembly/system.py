@@ -17,6 +17,7 @@ homogeneous on supported dofs. The system knows nothing about beams or contact.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from dataclasses import dataclass
 from typing import Protocol, Sequence
@@ -108,6 +109,8 @@ class System:
                                       "(linear_solver='direct' or 'auto')")
         for c in self.contributions:
             c.bind(self)
+        self._version = 0          # counts changes of the configuration
+        self._tangent_version = -1  # the configuration of a tangent assembled ahead (tangent_at)
         self.C: PETSc.Mat | None = None   # the contributions' matrix over their declared couplings
         self._merged = False
         self.pattern_builds = 0
@@ -121,6 +124,7 @@ class System:
                                              model.near_nullspace_modes())
         self.linear = petsc.LinearSolver(self.comm, self.A, self.iterative, symmetric, options_prefix, nullspace,
                                          fixed_rtol=not model.large_rotations)
+        self._fields_setup()
 
     # -- layout (one mesh: DOLFINx's own) -------------------------------------------
     def _build(self) -> None:
@@ -205,6 +209,7 @@ class System:
 
     def set_global_arrays(self, arrays: dict) -> None:
         """Restore configuration and contribution states from :meth:`global_arrays`' output."""
+        self._version += 1
         for i, m in enumerate(self.models):
             m.state.x.array[:] = m.from_global(arrays[f"state{i}"])
         for i, c in enumerate(self.contributions):
@@ -233,13 +238,84 @@ class System:
         self.fext_total.scale(load_factor)
         for amp, v in self.amplitude_loads:
             self.fext_total.axpy(amp(load_factor), v)
-        ref = max(self.fext_total.norm(), self.fint.norm())
         self.fext_total.copy(self.b)
         self.b.axpy(-1.0, self.fint)
         self._constrain_residual(load_factor)
-        norm = self.b.norm()
+        rot = self._rot
+        squares = np.zeros(6)
+        for k, v in enumerate((self.b, self.fext_total, self.fint)):
+            a = v.array
+            squares[2 * k] = a[~rot] @ a[~rot]
+            squares[2 * k + 1] = a[rot] @ a[rot]
+        squares = self.comm.allreduce(squares, op=MPI.SUM)
+        norm = math.sqrt(squares[0] + squares[1])
+        ref = max(math.sqrt(squares[2] + squares[3]), math.sqrt(squares[4] + squares[5]))
+        # per field (forces; moments on rotational dofs), each against its own scale
+        ref_f = max(math.sqrt(squares[2]), math.sqrt(squares[4]))
+        self.fields = {"force": (math.sqrt(squares[0]), ref_f)}
+        if self.has_rotations:
+            ref_m = max(math.sqrt(squares[3]), math.sqrt(squares[5]))
+            ell = self.length_scale
+            self.fields = {"force": (math.sqrt(squares[0]), max(ref_f, ref_m / ell if ell > 0.0 else 0.0)),
+                           "moment": (math.sqrt(squares[1]), max(ref_m, ell * ref_f))}
         self.timings.assembly += time.perf_counter() - t
         return norm, ref
+
+    # -- convergence measures: fields and the round-off floor -------------------------
+    def _rotation_mask(self) -> np.ndarray:
+        """Owned entries of the system's vectors that are rotations (True) or translations."""
+        m = self.model
+        mask = np.zeros((self.b.getLocalSize() // m.ndof, m.ndof), dtype=bool)
+        mask[:, m.translations:] = True
+        return mask.ravel()
+
+    def _fields_setup(self) -> None:
+        """Which dofs carry moments; the model's length and coordinate scales (round-off floor)."""
+        self._rot = self._rotation_mask()
+        self.has_rotations = bool(self.comm.allreduce(int(self._rot.any()), op=MPI.MAX))
+        lo, hi, big = [], [], 0.0
+        for m in self.models:
+            X = m.V.mesh.geometry.x[:, : m.gdim]
+            if len(X):
+                lo.append(X.min(axis=0))
+                hi.append(X.max(axis=0))
+                big = max(big, float(np.abs(X).max()))
+        gd = self.models[0].gdim
+        lo = self.comm.allreduce(np.min(lo, axis=0) if lo else np.full(gd, np.inf), op=MPI.MIN)
+        hi = self.comm.allreduce(np.max(hi, axis=0) if hi else np.full(gd, -np.inf), op=MPI.MAX)
+        self.length_scale = float(np.linalg.norm(hi - lo))
+        self.coordinate_scale = self.comm.allreduce(big, op=MPI.MAX)
+        self.floors = {"force": 0.0, "moment": 0.0}
+        self._diagonal = None
+
+    def _update_floor(self) -> None:
+        """The residual's round-off floor per field, from the tangent just assembled: an internal
+        force computed from coordinates of size c carries errors of about ε K_ii c on dof i
+        (ε K_ii on a rotation, angles of order one), so no residual below
+        ε ‖diag(K) c‖ can be told from zero."""
+        if self._diagonal is None:
+            self._diagonal = self.A.createVecLeft()
+        self.A.getDiagonal(self._diagonal)
+        d = np.abs(self._diagonal.array)
+        rot = self._rot
+        eps = np.finfo(float).eps
+        sq = self.comm.allreduce(np.array([(d[~rot] @ d[~rot]) * self.coordinate_scale**2, d[rot] @ d[rot]]),
+                                 op=MPI.SUM)
+        self.floors = {"force": eps * math.sqrt(sq[0]), "moment": eps * math.sqrt(sq[1])}
+
+    def correction_norms(self) -> dict[str, tuple[float, float]]:
+        """Per field: (‖dx‖, ‖Σ corrections of the step‖) — translations, rotations."""
+        rot = self._rot
+        sq = np.zeros(4)
+        for k, v in enumerate((self.dx, self.step_dx)):
+            a = v.array
+            sq[2 * k] = a[~rot] @ a[~rot]
+            sq[2 * k + 1] = a[rot] @ a[rot]
+        sq = np.sqrt(self.comm.allreduce(sq, op=MPI.SUM))
+        out = {"force": (sq[0], sq[2])}
+        if self.has_rotations:
+            out["moment"] = (sq[1], sq[3])
+        return out
 
     def _assemble_parts_matrix(self) -> None:
         self.A.zeroEntries()
@@ -248,11 +324,16 @@ class System:
 
     def jacobian(self) -> None:
         """Assemble the tangent K = ∂f_int/∂x (parts and contributions), identity rows/columns on
-        supports."""
+        supports; a tangent that :meth:`tangent_at` assembled at this very configuration is kept
+        (parts alone: it depends on the configuration only)."""
+        if self._tangent_version == self._version and self.tangent_reusable:
+            self._tangent_version = -1
+            return
         t = time.perf_counter()
         self._assemble_parts_matrix()
         self._add_contribution_tangents()
         self._constrain_matrix()
+        self._update_floor()
         self.linear.operator_changed()
         self.timings.assembly += time.perf_counter() - t
 
@@ -325,6 +406,64 @@ class System:
     def negative_eigenvalues(self) -> int | None:
         return self.linear.negative_eigenvalues()
 
+    # -- stability of the tangent -----------------------------------------------------
+    @property
+    def counts_inertia(self) -> bool:
+        """Whether every factorization of the Newton solver counts negative eigenvalues (LDLᵀ)."""
+        return self.linear.ldlt
+
+    def take_inertia(self) -> tuple[list[int], list[int]]:
+        """(negative-eigenvalue counts, determinant signs) of the tangents factorized since the
+        last call (LDLᵀ gives counts, LU signs)."""
+        return self.linear.take_inertia()
+
+    @property
+    def tangent_reusable(self) -> bool:
+        # contributions may change their pairs when a solve begins; prescribed motion of coupled
+        # parts is lifted while the tangent is constrained
+        return not self.contributions and not (self.model.coupled and self.has_prescribed_motion)
+
+    def tangent_at(self, load_factor: float, factorize: bool = True) -> None:
+        """Assemble (and, with a direct solver, factorize) the tangent at the current configuration,
+        its contributions evaluated there; the next Newton solve from here uses it as it is."""
+        self._tangent_version = -1
+        self.residual(load_factor)
+        self.jacobian()
+        self._tangent_version = self._version
+        if factorize:
+            t = time.perf_counter()
+            self.linear.factorize()
+            self.timings.solve += time.perf_counter() - t
+
+    def inertia(self) -> int:
+        """Negative eigenvalues of the symmetric part of the last assembled tangent (an LDLᵀ
+        factorization of its own; −1: singular)."""
+        t = time.perf_counter()
+        try:
+            return self.linear.inertia()
+        finally:
+            self.timings.solve += time.perf_counter() - t
+
+    def smallest_eigenvalue(self) -> float:
+        """Eigenvalue closest to zero of the (symmetric part of the) last assembled tangent, the
+        constrained dofs taken out."""
+        return self.linear.smallest_eigenvalue(self.constrained_global_dofs())
+
+    def softest_motions(self, count: int) -> tuple[list, list[float]]:
+        """The ``count`` softest motions of the last assembled tangent (its null space if singular),
+        orthonormal, softest first, and their quotients ‖K v‖/max|diag K|."""
+        vectors = [self.new_vector() for _ in range(count)]
+        q = self.linear.null_space(self.constrained_global_dofs(), vectors)
+        for v in vectors:
+            v.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        return vectors, q
+
+    def set_model_array(self, model, values: np.ndarray, vec: PETSc.Vec) -> None:
+        """vec = ``values`` (local array in the layout of ``model.V``) on the model's dofs, 0 elsewhere."""
+        with vec.localForm() as f:
+            f.set(0.0)
+            f.array[:] = values
+
     @property
     def krylov_iterations(self) -> int:
         return self.linear.krylov_iterations
@@ -345,6 +484,7 @@ class System:
     def update(self, scale: float = 1.0) -> None:
         """x ← x ⊕ scale·dx through the model's update rule (multiplicative for rotations)."""
         t = time.perf_counter()
+        self._version += 1
         if scale != 1.0:
             self.dx.scale(scale)
         self.model.update(self.dx)
@@ -427,6 +567,7 @@ class System:
     def extrapolate(self, older, newer, factor: float) -> None:
         """Set x to newer ⊕ factor·(newer ⊖ older) (a secant predictor; configurations of
         :meth:`checkpoint`)."""
+        self._version += 1
         self.model.extrapolate(older[0], newer[0], factor)
 
     def checkpoint(self):
@@ -434,6 +575,7 @@ class System:
         return (self.model.checkpoint(), [c.checkpoint() for c in self.contributions])
 
     def restore(self, cp) -> None:
+        self._version += 1
         self.model.restore(cp[0])
         for c, state in zip(self.contributions, cp[1]):
             c.restore(state)
@@ -510,6 +652,19 @@ class CoupledSystem(System):
         vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         with vec.localForm() as f:
             return f.array[self.layout.local[i]].copy()
+
+    def set_model_array(self, model, values: np.ndarray, vec: PETSc.Vec) -> None:
+        with vec.localForm() as f:
+            f.set(0.0)
+            f.array[self.layout.local[self.model.models.index(model)]] = values
+
+    def _rotation_mask(self) -> np.ndarray:
+        arrays = []
+        for m, loc in zip(self.model.models, self.layout.local):
+            r = np.zeros((len(loc) // m.ndof, m.ndof))
+            r[:, m.translations:] = 1.0
+            arrays.append(r.ravel())
+        return self._owned_indicator(arrays) > 0
 
     def _owned_indicator(self, arrays: Sequence[np.ndarray]) -> np.ndarray:
         """Owned entries of Σ models' local arrays (a reduction over ranks)."""
@@ -603,6 +758,7 @@ class CoupledSystem(System):
 
     def update(self, scale: float = 1.0) -> None:
         t = time.perf_counter()
+        self._version += 1
         self.dx.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         with self.dx.localForm() as f:
             dxl = f.array

@@ -24,6 +24,13 @@ from .. import validate
 from ..result import Result
 from .newton import NewtonOptions, NewtonReport, Stepper, newton, solve_step
 from .run import CheckpointError, Run
+from .stability import (CriticalPoint, CriticalPointError, StabilityTracker, check_first_tangent,
+                        singular_model)
+
+STABILITY = ("auto", "on", "off")
+# a step whose Newton iterates crossed states less stable than both its ends is cut and retried;
+# a leap across a limit point is declared when it persists at 1/2**LEAP_CUTS of the nominal step
+LEAP_CUTS = 4
 
 logger = logging.getLogger(__name__)
 
@@ -37,6 +44,16 @@ class LoadControl:
     extrapolate: start each step from the secant extrapolation of the last
     converged increment instead of the last converged state (exact rollback
     still restores the converged state).
+
+    stability: count the negative eigenvalues of the tangent at every converged state
+    ('auto': free with the LDLᵀ solver, one extra LDLᵀ factorization per step otherwise for
+    systems of up to 200 000 dofs; 'on'; 'off'; see :mod:`~dolfinx_corot.solvers.stability`);
+    at_critical_point: where the count changes (a bifurcation) or a step leaps across a limit
+    point (its Newton iterates cross states less stable than both ends, and still do when the
+    step is cut to 1/16), the critical point is recorded (``result.critical_points``, with its load factor) and
+    'stop' (default) ends the run at the last state before it with a
+    :class:`~dolfinx_corot.solvers.stability.CriticalPointError`; 'continue' goes on (with a
+    warning): load control past a critical point follows an unstable or a remote branch.
     """
 
     steps: int = 10
@@ -45,9 +62,13 @@ class LoadControl:
     max_cuts: int = 8
     extrapolate: bool = False
     newton: NewtonOptions = NewtonOptions()
+    stability: str = "auto"
+    at_critical_point: str = "stop"
 
     def __post_init__(self):
         validate.whole("LoadControl", "steps", self.steps, 1)
+        validate.choice("LoadControl", "stability", self.stability, STABILITY)
+        validate.choice("LoadControl", "at_critical_point", self.at_critical_point, ("stop", "continue"))
         validate.whole("LoadControl", "max_cuts", self.max_cuts, 0)
         if self.load_factors is None and not (isinstance(self.final, (int, float)) and math.isfinite(self.final)
                                               and self.final != 0.0):
@@ -103,6 +124,9 @@ class LoadControl:
             start = self._restart_index(state, run.load_factor, restart)
         lam = run.load_factor
         previous = None
+        tracker = StabilityTracker(system, self.stability)
+        if run.history.rows and "negative_eigenvalues" in run.history.rows[-1]:
+            tracker.negative = int(run.history.rows[-1]["negative_eigenvalues"])
         for index in range(start, len(targets)):
             target = targets[index]
             cuts = 0
@@ -114,24 +138,129 @@ class LoadControl:
                     # secant predictor along the last converged increment
                     system.extrapolate(previous[1], cp, (trial - lam) / (lam - previous[0]))
                 system.before_step()
+                tracker.start_attempt()
+                first = run.step == 0 and run.cuts == 0 and restart is None
+                if first:
+                    check_first_tangent(run, lam)
                 report = solve_step(system, Stepper(trial), self.newton)
+                if not report.converged and report.singular_start and first:
+                    system.restore(cp)
+                    singular_model(run, report.reason)
+                if report.converged:
+                    absurd = run.implausible(self.newton.max_displacement)
+                    if absurd:
+                        system.restore(cp)
+                        run.fail(f"step {run.step + 1} to load factor {trial:.6g}: {absurd}")
                 if not report.converged:
                     system.restore(cp)
                     cuts += 1
                     run.cuts += 1
                     logger.info("step %d: lambda %.6g failed (%s); cut %d", run.step + 1, trial, report.reason, cuts)
                     if cuts > self.max_cuts:
+                        if previous is not None and tracker.enabled:
+                            self._limit_ahead(run, tracker, previous, lam, target)
                         run.fail(f"step {run.step + 1}: no convergence to load factor {trial:.6g} from "
                                  f"{lam:.6g} after {self.max_cuts} cuts; last attempt: {report.reason}. "
                                  "Try smaller steps, or arc-length past a limit point.")
                     continue
+                before, after, passed = tracker.converged(trial)
+                if passed and after == before and cuts < self.max_cuts and \
+                        abs(trial - lam) > abs(target - (targets[index - 1] if index else 0.0)) / 2**LEAP_CUTS:
+                    # the iterates crossed less stable states than both ends: a leap across a limit
+                    # point, or an overshoot of Newton's first iterates; a shorter step tells
+                    system.restore(cp)
+                    tracker.negative = before
+                    cuts += 1
+                    run.cuts += 1
+                    logger.info("step %d: the iterates to lambda %.6g crossed states less stable than both ends; "
+                                "cut %d", run.step + 1, trial, cuts)
+                    continue
+                if passed and after == before:
+                    passed = tracker.secant_unstable(cp, system.checkpoint(), lam, trial, before)
+                    if not passed:
+                        tracker.count_here(trial)  # the next step's first tangent again
+                extra = {} if after is None else {"negative_eigenvalues": after}
+                if before is not None and after is not None and (after != before or passed):
+                    self._critical_point(run, tracker, cp, previous, lam, trial, before, after, passed)
                 previous = (lam, cp)
                 lam = trial
-                run.record(lam, report, cuts, started)
+                run.record(lam, report, cuts, started, extra)
                 reached = abs(target - lam) <= 1e-14 * max(1.0, abs(target))
                 run.save({**self.describe(), "next_target": index + 1 if reached else index})
                 cuts = max(cuts - 1, 0)
         return run.result()
+
+    def _limit_ahead(self, run: Run, tracker: StabilityTracker, previous, lam: float, target: float) -> None:
+        """Load control could not go beyond λ = ``lam``: if the smallest eigenvalue μ of the tangent
+        falls towards zero there — μ² extrapolated from the last two converged states vanishes
+        before ``target`` — a limit point lies ahead; record it and stop with its estimate."""
+        system = run.system
+        here = system.checkpoint()
+        mu0 = tracker.eigenvalue_here(lam)
+        system.restore(previous[1])
+        mum = tracker.eigenvalue_here(previous[0])
+        system.restore(here)
+        if not (mum**2 > mu0**2 > 0.0 and abs(mu0) < abs(mum)):
+            return
+        estimate = lam + mu0**2 * (lam - previous[0]) / (mum**2 - mu0**2)
+        if not min(lam, target) <= estimate <= max(lam, target):
+            return
+        point = CriticalPoint("limit point", float(estimate), (float(lam), float(target)), run.step + 1,
+                              int(tracker.negative or 0), int(tracker.negative or 0),
+                              "squared smallest eigenvalue extrapolated to zero")
+        run.critical_points.append(point)
+        run.fail(f"step {run.step + 1}: a limit point near load factor {estimate:.6g}: load control cannot go "
+                 f"beyond {lam:.6g} (towards {target:.6g}), where the smallest eigenvalue of the tangent "
+                 f"falls to zero. Follow the path with ArcLength (or prescribe a displacement: displacement "
+                 "control).", CriticalPointError)
+
+    def _critical_point(self, run: Run, tracker: StabilityTracker, cp, previous, lam: float, trial: float,
+                        before: int, after: int, passed: bool) -> None:
+        """Record the critical point crossed between λ = ``lam`` (state ``cp``) and ``trial`` (the
+        current state); stop there unless ``at_critical_point`` is 'continue'."""
+        system = run.system
+        here = system.checkpoint()
+        if after != before:
+            # a bifurcation: the eigenvalue closest to zero changes sign between the two states
+            kind = "bifurcation"
+            mu1 = tracker.eigenvalue_here(trial)
+            system.restore(cp)
+            mu0 = tracker.eigenvalue_here(lam)
+            if mu0 * mu1 < 0.0:
+                estimate, how = lam + (trial - lam) * mu0 / (mu0 - mu1), "smallest eigenvalue interpolated to zero"
+            else:
+                estimate, how = 0.5 * (lam + trial), "middle of the bracket"
+        else:
+            # the Newton iterates crossed an unstable region and landed on a stable state: the step
+            # leapt across a limit point (snap-through); near it the smallest eigenvalue μ goes as
+            # √(λc − λ), so μ² is extrapolated to zero from the last two states before it
+            kind = "limit point (jumped)"
+            system.restore(cp)
+            mu0 = tracker.eigenvalue_here(lam)
+            estimate, how = 0.5 * (lam + trial), "middle of the bracket"
+            if previous is not None:
+                system.restore(previous[1])
+                mum = tracker.eigenvalue_here(previous[0])
+                if mum**2 > mu0**2 > 0.0:
+                    estimate = lam + mu0**2 * (lam - previous[0]) / (mum**2 - mu0**2)
+                    estimate = min(max(estimate, min(lam, trial)), max(lam, trial))
+                    how = "squared smallest eigenvalue extrapolated to zero"
+            system.restore(cp)
+        point = CriticalPoint(kind, float(estimate), (float(lam), float(trial)), run.step + 1, int(before),
+                              int(after), how)
+        run.critical_points.append(point)
+        change = (f"the Newton iterates crossed states whose tangent has more than {before} negative "
+                  "eigenvalues" if after == before else f"negative eigenvalues of the tangent {before} → {after}")
+        words = (f"step {run.step + 1}: a {kind} near load factor {estimate:.6g} (between {lam:.6g} and "
+                 f"{trial:.6g}; {change})")
+        if self.at_critical_point == "stop":
+            system.restore(cp)
+            tracker.negative = before
+            run.fail(f"{words}: past it, load control follows an unstable or a remote branch. Follow the path "
+                     "with ArcLength (or prescribe a displacement: displacement control); "
+                     "LoadControl(at_critical_point='continue') goes on regardless.", CriticalPointError)
+        logger.warning("%s; continuing under load control", words)
+        system.restore(here)
 
 
 class ArcLengthStepper(Stepper):
@@ -206,7 +335,10 @@ class ArcLength:
     max_steps; max_load_factor: stop when |λ| reaches it; stop: a function of
     the history row that returns True to stop (e.g. a displacement reached);
     psi: load term weight (0: cylindrical); max_growth: largest factor by which Δl
-    grows from one step to the next.
+    grows from one step to the next; stability: count the negative eigenvalues of the tangent
+    at every converged state (as for :class:`LoadControl`) and list the limit points (where λ
+    turns) and bifurcations (where the count changes while λ does not turn) in
+    ``result.critical_points``.
     """
 
     initial_increment: float = 0.05
@@ -220,8 +352,10 @@ class ArcLength:
     max_growth: float = 1.5
     max_cuts: int = 8
     newton: NewtonOptions = field(default_factory=NewtonOptions)
+    stability: str = "auto"
 
     def __post_init__(self):
+        validate.choice("ArcLength", "stability", self.stability, STABILITY)
         validate.whole("ArcLength", "max_steps", self.max_steps, 1)
         validate.whole("ArcLength", "max_cuts", self.max_cuts, 0)
         validate.whole("ArcLength", "desired_iterations", self.desired_iterations, 1)
@@ -264,6 +398,8 @@ class ArcLength:
         arc = None
         arc_min = arc_max = None
         cuts = 0
+        tracker = StabilityTracker(system, self.stability)
+        pending = None
         if restart is not None:
             state, arrays = run.load(restart, "ArcLength")
             arc, arc_min, arc_max = state["arc"], state["arc_min"], state["arc_max"]
@@ -275,11 +411,20 @@ class ArcLength:
             started = run.begin()
             report = NewtonReport(False, 0)
             system.before_step()
+            first = run.step == 0 and run.cuts == 0 and restart is None
+            if first:
+                check_first_tangent(run, lam)
             try:
                 # predictor along the tangent (of the converged state: contributions evaluated there)
                 system.residual(lam)
                 system.jacobian()
-                system.solve(f, dxt)
+                try:
+                    system.solve(f, dxt)
+                except np.linalg.LinAlgError as err:
+                    if first:
+                        system.restore(cp)
+                        singular_model(run, str(err))
+                    raise
                 tnorm = math.sqrt(dxt.dot(dxt) + psi2F)
                 if arc is None:
                     arc = abs(self.initial_increment) * tnorm
@@ -320,11 +465,21 @@ class ArcLength:
                              f"{cuts - 1} cuts (arc length {arc:.3e}); last attempt: {report.reason}")
                 arc /= 2
                 continue
+            before, after, _ = tracker.converged(lam + Dlam)
+            if pending is not None:
+                pending["arc_next"] = arc
+                self._classify(run, pending, turned=Dlam * pending["Dlam"] < 0.0, lam_next=lam + Dlam)
+                pending = None
+            if before is not None and after is not None and after != before:
+                pending = self._event(run, tracker, cp, lam, lam + Dlam, Dlam, dlam_prev, before, after)
             lam += Dlam
             Dx.copy(Dx_prev)
             dlam_prev = Dlam
             have_prev = True
-            row = run.record(lam, report, cuts, started, {"arc_length": arc})
+            extra = {"arc_length": arc}
+            if after is not None:
+                extra["negative_eigenvalues"] = after
+            row = run.record(lam, report, cuts, started, extra)
             cuts = 0
             factor = math.sqrt(self.desired_iterations / max(report.iterations, 1))
             arc = min(max(arc * min(max(factor, 0.5), self.max_growth), arc_min), arc_max)
@@ -332,6 +487,55 @@ class ArcLength:
                       "dlam_prev": dlam_prev, "have_prev": have_prev}, {"Dx_prev": Dx_prev})
             if abs(lam) >= self.max_load_factor or (self.stop is not None and self.stop(row)):
                 break
+        if pending is not None:
+            self._classify(run, pending, turned=False, lam_next=None)
         for v in (f, dxt, dxr, Dx, Dx_prev):
             v.destroy()
         return run.result()
+
+    @staticmethod
+    def _event(run: Run, tracker: StabilityTracker, cp, lam: float, lam_new: float, Dlam: float,
+               dlam_prev: float, before: int, after: int) -> dict:
+        """A change of the count between λ = ``lam`` (state ``cp``) and ``lam_new`` (current): the
+        eigenvalue closest to zero on either side, for a bifurcation's estimate."""
+        system = run.system
+        here = system.checkpoint()
+        mu1 = tracker.eigenvalue_here(lam_new)
+        system.restore(cp)
+        mu0 = tracker.eigenvalue_here(lam)
+        system.restore(here)
+        tracker.system.tangent_at(lam_new)  # the next predictor's tangent
+        tracker.system.take_inertia()
+        return {"step": run.step + 1, "lam": lam, "lam_new": lam_new, "Dlam": Dlam, "before": before,
+                "after": after, "mu": (mu0, mu1), "turned": dlam_prev * Dlam < 0.0}
+
+    @staticmethod
+    def _classify(run: Run, e: dict, turned: bool, lam_next: float | None) -> None:
+        """A limit point if λ turns at the event's step or the next (its load factor: the vertex of
+        the parabola through the three path points around it), else a bifurcation (the smallest
+        eigenvalue interpolated to zero)."""
+        lam, lam_new = e["lam"], e["lam_new"]
+        if e["turned"] or turned:
+            rows = run.history.rows
+            estimate, how = lam_new, "load factor of the path point nearest to it"
+            if len(rows) >= 2 and lam_next is not None:
+                # λ(s) along the path's arc length s: a parabola through the last three points
+                y = np.array([rows[-2]["load_factor"], rows[-1]["load_factor"], lam_next])
+                s = np.array([0.0, rows[-1]["arc_length"], rows[-1]["arc_length"] + e["arc_next"]])
+                c = np.polyfit(s, y, 2)
+                vertex = -c[1] / (2 * c[0]) if c[0] != 0.0 else -1.0
+                if s[0] <= vertex <= s[2]:
+                    estimate, how = float(np.polyval(c, vertex)), "parabola through the path points around it"
+            kind = "limit point"
+        else:
+            mu0, mu1 = e["mu"]
+            kind = "bifurcation"
+            if mu0 * mu1 < 0.0:
+                estimate, how = lam + (lam_new - lam) * mu0 / (mu0 - mu1), "smallest eigenvalue interpolated to zero"
+            else:
+                estimate, how = 0.5 * (lam + lam_new), "middle of the bracket"
+        point = CriticalPoint(kind, float(estimate), (float(lam), float(lam_new)), e["step"], int(e["before"]),
+                              int(e["after"]), how)
+        run.critical_points.append(point)
+        logger.info("arc-length: a %s near load factor %.6g (negative eigenvalues %d → %d)", kind, estimate,
+                    e["before"], e["after"])

@@ -2,10 +2,25 @@
 
 Each iteration assembles r = λ f_ext − f_int(x) and K = ∂f_int/∂x, solves
 K dx = r and updates x ← x ⊕ dx through the system's update rule
-(multiplicative for rotations). Convergence: ‖r‖ ≤ rtol·ref + atol, with ref
-the larger of ‖λ f_ext‖ and ‖f_int‖ (reactions included). Divergence
-(NaN, growth of ‖r‖ by ``divergence_factor``, or ``max_iterations``) is
-reported, never hidden: the driver then cuts the step and restores the last
+(multiplicative for rotations).
+
+Convergence is judged field by field — forces on the translations, moments
+on the rotations — so that the test is homogeneous in each field's units
+and a model in mm converges as the same model in m (a single norm would
+add N to N·mm). A field converges when ‖r‖ ≤ rtol·ref + atol, with ref the
+larger of ‖λ f_ext‖ and ‖f_int‖ over the field (reactions included; for
+moments at least ℓ·ref_forces, for forces at least ref_moments/ℓ, with ℓ
+the diagonal of the model's bounding box), or when it has reached the
+round-off floor of the residual and stopped falling there. The floor is
+estimated from the assembled tangent: internal forces computed from
+coordinates of size c carry errors of about ε K_ii c (ε K_ii on a
+rotation), so ‖r‖ ≤ ε‖diag(K)·c‖ cannot be told from zero (a stiffness
+10⁴ times too large, or loads 10⁸ times below the stiffness, put the
+tolerance below that floor). The correction test ‖dx‖ ≤ xtol‖Δx‖ is
+field by field as well. Divergence (NaN, growth of ‖r‖ above the floor
+``max_growth`` times running or by ``divergence_factor``, or
+``max_iterations``) is reported with the criterion that was not met and its
+level, never hidden: the driver then cuts the step and restores the last
 converged state.
 
 Line search (Crisfield 1991, §9.3.2): with g(s) = dx·r(x ⊕ s·dx), the energy
@@ -52,7 +67,9 @@ class NewtonOptions:
     final tolerance needs; direct solvers ignore it;
     preconditioner: 'step' builds the iterative solver's preconditioner (AMG) from the first
     tangent of each step and keeps it for the step's later iterations, 'iteration' rebuilds it
-    every iteration."""
+    every iteration;
+    max_displacement: a converged state whose displacement exceeds this many times the model's
+    size is absurd (loads or materials in the wrong units), and the run stops there."""
 
     rtol: float = 1e-9
     atol: float = 0.0
@@ -68,6 +85,7 @@ class NewtonOptions:
     forcing_max: float = 1e-2
     forcing_gamma: float = 0.9
     preconditioner: str = "step"
+    max_displacement: float = 1e3
 
     def __post_init__(self):
         for name in ("rtol", "atol", "xtol"):
@@ -78,6 +96,7 @@ class NewtonOptions:
         validate.whole("NewtonOptions", "max_growth", self.max_growth, 1)
         validate.whole("NewtonOptions", "line_search_trials", self.line_search_trials, 0)
         validate.positive("NewtonOptions", "divergence_factor", self.divergence_factor)
+        validate.positive("NewtonOptions", "max_displacement", self.max_displacement)
         if self.preconditioner not in ("step", "iteration"):
             raise ValueError(f"NewtonOptions: preconditioner = {self.preconditioner!r} is not 'step' or "
                              "'iteration'")
@@ -92,6 +111,7 @@ class NewtonReport:
     reason: str = ""
     updates: int = 0  # contributions' state updates after convergence (augmented-Lagrangian: Uzawa)
     load_factor: float = math.nan  # where the solve ended
+    singular_start: bool = False  # the first tangent of the solve could not be factorized
 
     def rate(self) -> float:
         """Estimated order of convergence from the last three residuals (nan if too few)."""
@@ -154,9 +174,10 @@ def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin:
     growth = 0
     small_correction = False
     eta = None
+    previous = None  # the fields' residuals one iteration back
     for it in range(1, options.max_iterations + 1):
         tol = options.rtol * ref + options.atol
-        if norm <= tol or small_correction:
+        if within_tolerance(system, options, previous) or small_correction:
             report.converged = True
             break
         if system.iterative:
@@ -165,11 +186,13 @@ def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin:
                 eta = forcing_term(options, norm, report.residuals[-2] if it > 1 else None,
                                    eta if it > 1 else None, tol)
                 system.set_forcing(eta)
+        fields = dict(system.fields)
         system.jacobian()
         try:
             report.increments.append(stepper.correct(system, system.correction_rhs()))
         except np.linalg.LinAlgError as err:
             report.reason = str(err)
+            report.singular_start = it == 1
             break
         factor = system.limit_correction()  # e.g. contact nodes move at most a search margin
         if factor < 1.0:
@@ -186,29 +209,65 @@ def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin:
             norm, ref = system.residual(stepper.trial_load_factor(1.0))
         stepper.accept(system, s)
         report.iterations = it
-        small_correction = report.increments[-1] <= options.xtol * system.step_increment_norm()
+        small_correction = all(d <= options.xtol * total for d, total in system.correction_norms().values())
+        previous = fields
         report.residuals.append(norm)
         system.after_iteration(report.residuals)
         logger.debug("  Newton %2d: |r| = %.3e  |dx| = %.3e", it, norm, report.increments[-1])
         # the first corrections of a large-rotation step may raise |r| (a linear predictor
         # stretches rotating elements); divergence is growth three times running, or blow-up
-        growth = growth + 1 if norm > report.residuals[-2] else 0
+        # (residuals at their round-off floor wander: no growth there)
+        noise = all(r <= 2.0 * system.floors.get(name, 0.0) for name, (r, _) in system.fields.items())
+        growth = growth + 1 if norm > report.residuals[-2] and not noise else 0
         if not math.isfinite(norm) or (stepper.check_growth and (growth >= options.max_growth
                                                                  or norm > options.divergence_factor * scale)):
             report.reason = (f"diverged: |r| = {norm:.3e} after {it} iterations "
                              f"(initial {report.residuals[0]:.3e})")
             break
     else:
-        tol = options.rtol * ref + options.atol
-        report.converged = norm <= tol or small_correction
+        report.converged = within_tolerance(system, options, previous) or small_correction
         if not report.converged:
-            report.reason = (f"no convergence in {options.max_iterations} iterations: |r| = {norm:.3e} "
-                             f"> tolerance {tol:.3e}")
+            report.reason = f"no convergence in {options.max_iterations} iterations: {stall(system, options, report)}"
     if system.iterative:
         system.set_forcing(None)
         system.reuse_preconditioner(False)
     report.load_factor = stepper.load_factor
     return report
+
+
+def within_tolerance(system, options: NewtonOptions, previous: dict | None) -> bool:
+    """Each field of the residual (forces; moments, when the model has rotations) within
+    rtol × its own scale + atol, or at its round-off floor (``system.floors``) where it has
+    stopped falling (above half its value one iteration back): residuals below the floor are
+    round-off, which no iteration removes. Every test is homogeneous in its units, so a model
+    in mm converges as it does in m."""
+    for name, (r, ref) in system.fields.items():
+        if r <= options.rtol * ref + options.atol:
+            continue
+        if previous is not None and r <= system.floors.get(name, 0.0) and r > 0.5 * previous[name][0]:
+            continue
+        return False
+    return True
+
+
+def stall(system, options: NewtonOptions, report: NewtonReport) -> str:
+    """Which criterion was not met, and at what level."""
+    words = []
+    for name, (r, ref) in system.fields.items():
+        tol = options.rtol * ref + options.atol
+        if r <= tol:
+            continue
+        floor = system.floors.get(name, 0.0)
+        rel = f"{r / ref:.1e} of" if ref > 0.0 else "against"
+        words.append(f"the {name} residual |r| = {r:.3e} ({rel} its scale {ref:.3e}) is above the tolerance "
+                     f"{tol:.3e} (rtol {options.rtol:g}) and the round-off floor {floor:.1e} that the tangent's "
+                     "stiffness sets")
+    last = report.residuals[-4:]
+    if len(last) >= 4 and min(last[1:]) > 0.1 * last[0]:
+        words.append("it has stopped falling (" + ", ".join(f"{x:.2e}" for x in last) + "): a tangent that is "
+                     "not consistent, a singular or nearly singular tangent, or data out of scale (loads far "
+                     "below the stiffness)")
+    return "; ".join(words) if words else f"|r| = {report.residuals[-1]:.3e}"
 
 
 def solve_step(system, stepper, options: NewtonOptions, begin: bool = True) -> NewtonReport:
@@ -221,6 +280,7 @@ def solve_step(system, stepper, options: NewtonOptions, begin: bool = True) -> N
         again.updates = report.updates + 1
         again.iterations += report.iterations
         again.residuals = report.residuals + again.residuals
+        again.singular_start = False
         report = again
     if not report.converged and report.updates:
         report.reason = f"after {report.updates} contribution update(s): {report.reason}"

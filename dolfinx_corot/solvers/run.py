@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import math
 import os
 import time
 import zipfile
@@ -93,6 +94,8 @@ class Run:
         self.iterations = 0
         self.step = 0
         self.load_factor = 0.0
+        self.critical_points: list = []
+        self._size = None
         self._description = scene.describe()
         self.fingerprint = fingerprint(self._description)
         if checkpoint is not None:
@@ -152,7 +155,8 @@ class Run:
             meta = {"format": FORMAT, "fingerprint": self.fingerprint, "scene": self._description,
                     "large_rotations": self.scene.large_rotations, "step": self.step,
                     "load_factor": self.load_factor, "cuts": self.cuts, "iterations": self.iterations,
-                    "history": self.history.rows, "driver": driver_state, "profiles": list(self.profiles)}
+                    "history": self.history.rows, "driver": driver_state, "profiles": list(self.profiles),
+                    "critical_points": [c.as_dict() for c in self.critical_points]}
             for i, profile in enumerate(self.profiles.values()):
                 arrays.update(profile.arrays(f"profile{i}_"))
             tmp = self.checkpoint_path + ".tmp"
@@ -195,6 +199,9 @@ class Run:
         for row in meta["history"]:
             self.history.append(row)
         self._restore_profiles(path, meta.get("profiles", []), arrays)
+        from .stability import CriticalPoint
+        self.critical_points = [CriticalPoint(**{**c, "bracket": tuple(c["bracket"])})
+                                for c in meta.get("critical_points", [])]
         return meta["driver"], arrays
 
     def _restore_profiles(self, path: str, saved: list, arrays: dict) -> None:
@@ -217,11 +224,48 @@ class Run:
         return {"steps": len(self.history), "newton_iterations": self.iterations, "cuts": self.cuts,
                 "wall_time": time.perf_counter() - self.t_start}
 
-    def fail(self, msg: str):
-        raise ConvergenceError(msg, Result(self.history, False, msg, self.totals(), self.profiles))
+    def fail(self, msg: str, error=ConvergenceError):
+        raise error(msg, Result(self.history, False, msg, self.totals(), self.profiles, list(self.critical_points)))
 
     def result(self, message: str = "") -> Result:
-        return Result(self.history, True, message, self.totals(), self.profiles)
+        return Result(self.history, True, message, self.totals(), self.profiles, list(self.critical_points))
+
+    # -- plausibility ---------------------------------------------------------------------
+    def model_size(self) -> float:
+        """The diameter of the parts' reference bounding box."""
+        if self._size is None:
+            lo, hi = [], []
+            for m in self.system.models:
+                X = m.V.tabulate_dof_coordinates()[:, : m.gdim]
+                if len(X):
+                    lo.append(X.min(axis=0))
+                    hi.append(X.max(axis=0))
+            gd = self.system.models[0].gdim
+            lo = np.min(lo, axis=0) if lo else np.full(gd, np.inf)
+            hi = np.max(hi, axis=0) if hi else np.full(gd, -np.inf)
+            comm = self.system.comm
+            from mpi4py import MPI
+            lo = comm.allreduce(lo, op=MPI.MIN)
+            hi = comm.allreduce(hi, op=MPI.MAX)
+            self._size = float(max(np.linalg.norm(hi - lo), 1e-300))
+        return self._size
+
+    def implausible(self, limit: float) -> str | None:
+        """Why the converged state is absurd (a displacement larger than ``limit`` model sizes, or
+        not finite), or None."""
+        from mpi4py import MPI
+        largest = 0.0
+        for m in self.system.models:
+            n = m.V.dofmap.index_map.size_local
+            u = m.translations_of(np.arange(n))
+            if u.size:
+                largest = max(largest, float(np.max(np.abs(u))) if np.all(np.isfinite(u)) else math.inf)
+        largest = self.system.comm.allreduce(largest, op=MPI.MAX)
+        size = self.model_size()
+        if math.isfinite(largest) and largest <= limit * size:
+            return None
+        return (f"the converged displacement reaches {largest:.3e}, {largest / size:.3g} times the model's size "
+                f"{size:.3g}: the result is absurd (check the magnitude and units of the loads and materials)")
 
 
 def solve(scene, driver, system: System | None = None, on_step=None, checkpoint: str | None = None,

@@ -1,0 +1,213 @@
+"""Stability of the tangent along the path: critical points under load control and arc-length,
+singular models stopped at the first solve with their free motion named, absurd results refused.
+
+References: Euler's critical load of a cantilever column, P = π²EI/(4L²); the limit load of
+the shallow two-bar (von Mises) truss with bars of constant EA on the engineering strain,
+P(w) = 2EA (1 − l/L)(h − w)/l, l = √(a² + (h − w)²), maximised over the apex deflection w.
+"""
+import math
+import time
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import dolfinx_corot as dc
+from dolfinx_corot.io.gmsh_models import polyline
+from dolfinx_corot.io.mesh import box, from_arrays
+from dolfinx_corot.result import limit_load
+
+E, B, H, L = 1.0e6, 0.01, 0.01, 1.0
+I_WEAK = B * H**3 / 12
+P_EULER = math.pi**2 * E * I_WEAK / (4 * L**2)  # cantilever column
+
+
+def _column(gdim: int, n: int = 10):
+    """A perfect cantilever column under its Euler load at λ = 1 (2D: I = bh³/12; 3D: a b × 1.5h
+    section, whose weak axis has 1.5 I, so λ_cr = 1.5)."""
+    pts = [[0.0, 0.0], [0.0, L]] if gdim == 2 else [[0.0, 0.0, 0.0], [0.0, 0.0, L]]
+    tm = polyline(pts, n, line_name="col", gdim=gdim)
+    sc = dc.Scene()
+    section = dc.Rectangle(B, H) if gdim == 2 else dc.Rectangle(B, 1.5 * H)
+    col = sc.add_beam(tm, "col", section=section, material=dc.Elastic(E, 0.3), orientation=(1.0, 0.0, 0.0))
+    sc.fix(col, "base")
+    sc.load(col, "tip", force=(0.0, -P_EULER) if gdim == 2 else (0.0, 0.0, -P_EULER))
+    sc.monitor("tip", col, "tip")
+    return sc
+
+
+def test_load_control_stops_at_the_bifurcation_of_a_column():
+    """Load control on a perfect column past its Euler load: the tangent gains a negative
+    eigenvalue between λ = 0.91 and 1.04; the run stops at the last state before it with the
+    critical load, interpolated from the smallest eigenvalue, within 0.5 % of π²EI/(4L²)
+    (it is within 1e-4: the rest is the column's axial shortening)."""
+    with pytest.raises(dc.CriticalPointError, match=r"a bifurcation near load factor 1\.0000.*ArcLength") as err:
+        dc.solve(_column(2), dc.LoadControl(steps=10, final=1.3))
+    result = err.value.result
+    assert not result.completed and len(result.history) == 7
+    assert result.history.rows[-1]["load_factor"] == pytest.approx(0.91)
+    (cp,) = result.critical_points
+    assert cp.kind == "bifurcation" and cp.bracket == pytest.approx((0.91, 1.04))
+    assert (cp.negative_before, cp.negative_after) == (0, 1)
+    assert cp.load_factor == pytest.approx(1.0, rel=5e-3)
+    assert cp.load_factor == pytest.approx(1.0, abs=1e-4)
+
+
+@pytest.mark.parametrize("gdim, critical", [(2, 1.0), (3, 1.5)])
+def test_load_control_may_go_on_past_a_bifurcation(gdim, critical):
+    """With at_critical_point='continue' the run completes on the straight (unstable) path and
+    records the critical point; 3D frames, solved by LU, count the negative eigenvalues by an
+    LDLᵀ of the symmetric part of the tangent at each converged state."""
+    final = 1.3 * critical
+    result = dc.solve(_column(gdim), dc.LoadControl(steps=10, final=final, at_critical_point="continue"))
+    assert result.completed and len(result.history) == 10
+    (cp,) = result.critical_points
+    assert cp.kind == "bifurcation" and cp.load_factor == pytest.approx(critical, rel=5e-3)
+    lam = result.history.column("load_factor")
+    negative = result.history.column("negative_eigenvalues")
+    assert np.array_equal(negative, (lam > critical).astype(float))
+
+
+A_TRUSS, H_TRUSS, EA_TRUSS, F_TRUSS = 1.0, 0.1, 1.0e4, 10.0
+
+
+def _truss_limit() -> float:
+    L0 = math.hypot(A_TRUSS, H_TRUSS)
+    w = np.linspace(0.0, H_TRUSS, 400001)
+    ell = np.hypot(A_TRUSS, H_TRUSS - w)
+    return float(np.max(2 * EA_TRUSS * (1 - ell / L0) * (H_TRUSS - w) / ell) / F_TRUSS)
+
+
+def _truss():
+    tm = from_arrays(np.array([[-A_TRUSS, 0.0], [0.0, H_TRUSS], [A_TRUSS, 0.0]]), np.array([[0, 1], [1, 2]]),
+                     "bars", point_groups={"supports": [0, 2], "apex": [1]})
+    sc = dc.Scene()
+    bars = sc.add_truss(tm, "bars", area=1.0, material=dc.Elastic(EA_TRUSS))
+    sc.fix(bars, "supports")
+    sc.load(bars, "apex", force=(0.0, -F_TRUSS))
+    sc.monitor("apex", bars, "apex")
+    return sc
+
+
+def test_load_control_past_a_limit_point_stops_instead_of_jumping():
+    """Past the truss's limit load, load control used to leap to the inverted branch (apex
+    −0.04 → −0.216) and report completion. Now the step that leaps is recognised — its Newton
+    iterates cross states with a negative eigenvalue — and the run stops before it; the bracket
+    holds the exact limit load, and its estimate (smallest eigenvalue squared, extrapolated) is
+    within 0.5 %. With 'continue' the leap is recorded and the run goes on."""
+    exact = _truss_limit()
+    with pytest.raises(dc.CriticalPointError, match="limit point") as err:
+        dc.solve(_truss(), dc.LoadControl(steps=10, final=2.0))
+    (cp,) = err.value.result.critical_points
+    assert cp.kind == "limit point (jumped)"
+    assert cp.bracket[0] <= exact <= cp.bracket[1]
+    assert cp.load_factor == pytest.approx(exact, rel=5e-3)
+    assert err.value.result.history.rows[-1]["apex_uy"] > -0.05  # nothing of the remote branch kept
+    # the model itself: the first step's apex deflection satisfies P(w) of the bars exactly
+    first = err.value.result.history.rows[0]
+    w = -first["apex_uy"]
+    L0, ell = math.hypot(A_TRUSS, H_TRUSS), math.hypot(A_TRUSS, H_TRUSS - w)
+    assert 2 * EA_TRUSS * (1 - ell / L0) * (H_TRUSS - w) / ell == pytest.approx(F_TRUSS * first["load_factor"],
+                                                                                 rel=1e-6)
+    result = dc.solve(_truss(), dc.LoadControl(steps=10, final=2.0, at_critical_point="continue"))
+    assert result.completed and [c.kind for c in result.critical_points] == ["limit point (jumped)"]
+
+
+def test_arc_length_lists_the_limit_point():
+    """Arc-length follows the truss through its limit point: the count of negative eigenvalues
+    changes where λ turns, and the limit point's load (a parabola through the path points around
+    it) is within 2 % of the exact one for this coarse path."""
+    exact = _truss_limit()
+    result = dc.solve(_truss(), dc.ArcLength(initial_increment=0.05, max_steps=8))
+    first = result.critical_points[0]
+    assert first.kind == "limit point" and (first.negative_before, first.negative_after) == (0, 1)
+    assert first.load_factor == pytest.approx(exact, rel=2e-2)
+
+
+def test_limit_load_says_when_the_path_has_no_maximum():
+    lam = np.linspace(0.0, 1.0, 6)
+    with pytest.raises(ValueError, match="the path has no maximum of the load inside it: its maximum is at its "
+                                         "last point"):
+        limit_load(lam, lam**2)
+    assert limit_load(np.array([0.0, 1.0, 1.6, 1.4]), np.array([0.0, 1.0, 2.0, 3.0])) == pytest.approx(1.625)
+
+
+# -- singular models ------------------------------------------------------------------------
+def _beam(fix):
+    tm = polyline([[0.0, 0.0], [1.0, 0.0]], 4, line_name="beam")
+    sc = dc.Scene()
+    b = sc.add_beam(tm, "beam", section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(1.0e3))
+    if fix is not None:
+        sc.fix(b, "base", fix)
+    sc.load(b, "tip", force=(0.0, -1.0))
+    return sc
+
+
+@pytest.mark.parametrize("fix, motions", [
+    (None, "translation along x, translation along y, rotation about z"),
+    (("ux",), "translation along y, rotation about z"),
+    (("ux", "uy"), "rotation about z through the point (0, 0)"),
+])
+def test_a_structure_without_enough_supports_stops_at_the_first_solve(fix, motions):
+    """No step halving: the first tangent is singular, the run stops at once and names the
+    part's free rigid motions (before: 'singular … Try smaller steps' after 8 cuts)."""
+    start = time.perf_counter()
+    with pytest.raises(dc.SingularModelError, match="the model is singular before any load") as err:
+        dc.solve(_beam(fix), dc.LoadControl(steps=2))
+    assert time.perf_counter() - start < 1.0
+    assert f"beam 'beam' moves freely ({motions})" in str(err.value)
+    assert "no support holds it" in str(err.value)
+    assert err.value.result.totals["cuts"] == 0 and len(err.value.result.history) == 0
+
+
+def test_a_solid_without_supports_is_named_before_the_iterative_solver_runs():
+    """CG + AMG does not see a singular tangent (before: 'diverged: |r| = 2.5e36'); the rigid-body
+    modes applied to the first tangent do."""
+    tm = box([1.0, 1.0, 1.0], [2, 2, 2])
+    sc = dc.Scene()
+    s = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(1.0e3, 0.3), degree=1)
+    sc.load(s, "x1", traction=(1.0, 0.0, 0.0))
+    with pytest.raises(dc.SingularModelError, match=r"solid \(all cells\) moves freely \(translation along x, "
+                                                    r"translation along y, translation along z, rotation about x"):
+        dc.solve(sc, dc.LoadControl(steps=1))
+
+
+def test_a_mechanism_is_located():
+    """Two collinear bars pinned at their far ends: the middle node can move across the line
+    without resistance (a mechanism at the start state); the message names the node."""
+    tm = from_arrays(np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]), np.array([[0, 1], [1, 2]]), "bars",
+                     point_groups={"ends": [0, 2], "middle": [1]})
+    sc = dc.Scene()
+    bars = sc.add_truss(tm, "bars", area=1.0, material=dc.Elastic(1.0e3))
+    sc.fix(bars, "ends")
+    sc.load(bars, "middle", force=(0.0, -1.0))
+    with pytest.raises(dc.SingularModelError, match=r"truss 'bars' deforms without resistance \(a mechanism\): "
+                                                    r"the node\(s\) at \(1, 0\) move most"):
+        dc.solve(sc, dc.LoadControl(steps=1))
+
+
+def test_an_absurd_result_stops_the_run():
+    """A load of 1e20 on a small cantilever used to 'complete' with a tip rotation of −1e19 rad:
+    a displacement a thousand times the model's size is refused at once, nothing is recorded."""
+    sc = _beam(None)
+    sc = dc.Scene()
+    tm = polyline([[0.0, 0.0], [1.0, 0.0]], 4, line_name="beam")
+    b = sc.add_beam(tm, "beam", section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(1.0e3))
+    sc.fix(b, "base")
+    sc.load(b, "tip", force=(0.0, -1e20))
+    with pytest.raises(dc.ConvergenceError, match=r"times the model's size 1: the result is absurd") as err:
+        dc.solve(sc, dc.LoadControl(steps=1))
+    assert len(err.value.result.history) == 0 and err.value.result.totals["cuts"] == 0
+
+
+def test_options_of_the_stability_checks():
+    with pytest.raises(ValueError, match=r"LoadControl: at_critical_point = 'ignore' is not one of"):
+        dc.LoadControl(at_critical_point="ignore")
+    with pytest.raises(ValueError, match=r"ArcLength: stability = 'yes' is not one of"):
+        dc.ArcLength(stability="yes")
+    with pytest.raises(ValueError, match=r"NewtonOptions: max_displacement = 0.0 must be"):
+        dc.NewtonOptions(max_displacement=0.0)
+    # tracking off: no column, no critical point, the column runs through its Euler load
+    result = dc.solve(_column(2), dc.LoadControl(steps=10, final=1.3, stability="off"))
+    assert result.completed and not result.critical_points and "negative_eigenvalues" not in result.history.columns
+    assert MPI.COMM_WORLD.allreduce(1) >= 1

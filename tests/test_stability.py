@@ -211,3 +211,30 @@ def test_options_of_the_stability_checks():
     result = dc.solve(_column(2), dc.LoadControl(steps=10, final=1.3, stability="off"))
     assert result.completed and not result.critical_points and "negative_eigenvalues" not in result.history.columns
     assert MPI.COMM_WORLD.allreduce(1) >= 1
+
+
+@pytest.mark.parametrize("case, where", [
+    ("duplicate node", r"\(2, 0\), \(1, 0\)"),   # the second member hangs from nothing
+    ("I = 0", r"\(0.25, 0\)"),                   # no bending stiffness: the nodes swing
+])
+def test_duplicate_nodes_and_a_section_without_bending_stiffness_stop_at_the_first_solve(case, where):
+    """Before: 'the tangent stiffness is singular … Try smaller steps' after 8 halvings. Now the
+    first tangent's singularity stops the run at once (no cut, nothing recorded) and the nodes of
+    the free motion are named."""
+    if case == "duplicate node":  # two members meeting at x = 1 on separate nodes
+        tm = from_arrays(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [2.0, 0.0]]), np.array([[0, 1], [2, 3]]),
+                         "beam", point_groups={"base": [0], "tip": [3]})
+        section = dc.Rectangle(0.1, 0.1)
+    else:
+        tm = polyline([[0.0, 0.0], [1.0, 0.0]], 4, line_name="beam")
+        section = dc.Section(A=0.01, I=0.0)
+    sc = dc.Scene()
+    b = sc.add_beam(tm, "beam", section=section, material=dc.Elastic(1.0e3))
+    sc.fix(b, "base")
+    sc.load(b, "tip", force=(0.0, -1.0))
+    start = time.perf_counter()
+    with pytest.raises(dc.SingularModelError, match=r"beam 'beam' deforms without resistance \(a mechanism\): "
+                                                    r"the node\(s\) at .*" + where) as err:
+        dc.solve(sc, dc.LoadControl(steps=2))
+    assert time.perf_counter() - start < 1.0
+    assert err.value.result.totals["cuts"] == 0 and len(err.value.result.history) == 0

@@ -106,7 +106,9 @@ def compress(tm, degree: int, clamp: str):
     scene.prescribe(col, "tip", ux=-SHORTENING)
     scene.monitor("tip", col, "tip")
     scene.monitor_reaction("tip", col, "tip")
-    res, wall = timed(dc.solve, scene, dc.LoadControl(load_factors=LOAD_FACTORS))
+    # the path is traced through and past buckling on purpose: critical points are recorded
+    # (result.critical_points), not a reason to stop
+    res, wall = timed(dc.solve, scene, dc.LoadControl(load_factors=LOAD_FACTORS, at_critical_point="continue"))
     return scene, res, wall
 
 

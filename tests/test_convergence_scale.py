@@ -83,7 +83,7 @@ def test_a_solid_in_m_and_in_mm_takes_the_same_iterations():
 
 @pytest.mark.parametrize("gdim", [2, 3])
 def test_a_load_far_below_the_stiffness_converges_to_the_beam_theory_answer(gdim):
-    """F = 10⁻³ N on a beam of EA = 10⁷ N: the residual's round-off floor (about 5e-9 N here) is far
+    """F = 10⁻³ N on a beam of EA = 10⁷ N: the residual's round-off floor (about 1e-9 N here) is far
     above rtol·F = 1e-12 N. Before, the iterates wandered at the floor and the steps were cut until
     the run failed ("diverged: |r| = 3.9e-08"); now the floor is recognised, every step converges in
     at most 3 iterations, and the tip deflection is F L³/(3EI) to 1e-6."""

@@ -281,8 +281,10 @@ class System:
                 hi.append(X.max(axis=0))
                 big = max(big, float(np.abs(X).max()))
         gd = self.models[0].gdim
-        lo = self.comm.allreduce(np.min(lo, axis=0) if lo else np.full(gd, np.inf), op=MPI.MIN)
-        hi = self.comm.allreduce(np.max(hi, axis=0) if hi else np.full(gd, -np.inf), op=MPI.MAX)
+        lo_all, hi_all = np.empty(gd), np.empty(gd)
+        self.comm.Allreduce(np.min(lo, axis=0) if lo else np.full(gd, np.inf), lo_all, op=MPI.MIN)
+        self.comm.Allreduce(np.max(hi, axis=0) if hi else np.full(gd, -np.inf), hi_all, op=MPI.MAX)
+        lo, hi = lo_all, hi_all
         self.length_scale = float(np.linalg.norm(hi - lo))
         self.coordinate_scale = self.comm.allreduce(big, op=MPI.MAX)
         self.floors = {"force": 0.0, "moment": 0.0}

@@ -50,7 +50,8 @@ class LoadControl:
     systems of up to 200 000 dofs; 'on'; 'off'; see :mod:`~dolfinx_corot.solvers.stability`);
     at_critical_point: where the count changes (a bifurcation) or a step leaps across a limit
     point (its Newton iterates cross states less stable than both ends, and still do when the
-    step is cut to 1/16), the critical point is recorded (``result.critical_points``, with its load factor) and
+    step is cut to 1/16; the shorter retries are not failures: the history column
+    ``stability_retries`` counts them), the critical point is recorded (``result.critical_points``, with its load factor) and
     'stop' (default) ends the run at the last state before it with a
     :class:`~dolfinx_corot.solvers.stability.CriticalPointError`; 'continue' goes on (with a
     warning): load control past a critical point follows an unstable or a remote branch.
@@ -130,8 +131,10 @@ class LoadControl:
         for index in range(start, len(targets)):
             target = targets[index]
             cuts = 0
+            shorter = 0   # halvings of steps whose iterates crossed less stable states (not failures)
+            retried = 0
             while abs(target - lam) > 1e-14 * max(1.0, abs(target)):
-                trial = target if cuts == 0 else lam + (target - lam) / 2**cuts
+                trial = target if cuts + shorter == 0 else lam + (target - lam) / 2**(cuts + shorter)
                 cp = system.checkpoint()
                 started = run.begin()
                 if self.extrapolate and previous is not None and lam != previous[0]:
@@ -164,22 +167,25 @@ class LoadControl:
                                  "Try smaller steps, or arc-length past a limit point.")
                     continue
                 before, after, passed = tracker.converged(trial)
-                if passed and after == before and cuts < self.max_cuts and \
+                # past a critical point (the path already unstable) the iterates' counts say nothing
+                passed = passed and before == 0
+                if passed and after == before and cuts + shorter < self.max_cuts and \
                         abs(trial - lam) > abs(target - (targets[index - 1] if index else 0.0)) / 2**LEAP_CUTS:
                     # the iterates crossed less stable states than both ends: a leap across a limit
                     # point, or an overshoot of Newton's first iterates; a shorter step tells
                     system.restore(cp)
                     tracker.negative = before
-                    cuts += 1
-                    run.cuts += 1
+                    shorter += 1
+                    retried += 1
                     logger.info("step %d: the iterates to lambda %.6g crossed states less stable than both ends; "
-                                "cut %d", run.step + 1, trial, cuts)
+                                "retried with a step of 1/%d", run.step + 1, trial, 2**(cuts + shorter))
                     continue
                 if passed and after == before:
                     passed = tracker.secant_unstable(cp, system.checkpoint(), lam, trial, before)
                     if not passed:
                         tracker.count_here(trial)  # the next step's first tangent again
-                extra = {} if after is None else {"negative_eigenvalues": after}
+                extra = {} if after is None else {"negative_eigenvalues": after, "stability_retries": retried}
+                retried = 0
                 if before is not None and after is not None and (after != before or passed):
                     self._critical_point(run, tracker, cp, previous, lam, trial, before, after, passed)
                 previous = (lam, cp)
@@ -187,7 +193,10 @@ class LoadControl:
                 run.record(lam, report, cuts, started, extra)
                 reached = abs(target - lam) <= 1e-14 * max(1.0, abs(target))
                 run.save({**self.describe(), "next_target": index + 1 if reached else index})
-                cuts = max(cuts - 1, 0)
+                if shorter:
+                    shorter -= 1
+                else:
+                    cuts = max(cuts - 1, 0)
         return run.result()
 
     def _limit_ahead(self, run: Run, tracker: StabilityTracker, previous, lam: float, target: float) -> None:

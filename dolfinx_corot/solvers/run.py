@@ -234,20 +234,7 @@ class Run:
     def model_size(self) -> float:
         """The diameter of the parts' reference bounding box."""
         if self._size is None:
-            lo, hi = [], []
-            for m in self.system.models:
-                X = m.V.tabulate_dof_coordinates()[:, : m.gdim]
-                if len(X):
-                    lo.append(X.min(axis=0))
-                    hi.append(X.max(axis=0))
-            gd = self.system.models[0].gdim
-            lo = np.min(lo, axis=0) if lo else np.full(gd, np.inf)
-            hi = np.max(hi, axis=0) if hi else np.full(gd, -np.inf)
-            comm = self.system.comm
-            from mpi4py import MPI
-            lo = comm.allreduce(lo, op=MPI.MIN)
-            hi = comm.allreduce(hi, op=MPI.MAX)
-            self._size = float(max(np.linalg.norm(hi - lo), 1e-300))
+            self._size = float(max(self.system.length_scale, 1e-300))
         return self._size
 
     def implausible(self, limit: float) -> str | None:

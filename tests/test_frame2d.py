@@ -148,14 +148,19 @@ def test_failed_step_is_cut_and_the_state_restored_exactly():
 
 
 def test_snap_through_under_load_control_raises_with_the_converged_history():
-    """Past the limit load of a shallow truss load control cannot go on: a clear error, history kept."""
+    """Past the limit load of a shallow truss load control cannot go on: a clear error naming the
+    limit point (its load within 0.1 % of the exact 0.38109, from the smallest eigenvalue
+    extrapolated to zero), history kept."""
     sc, bars = _two_bar_truss(h=0.1)
     sc.load(bars, "apex", force=(0.0, -1.0))  # limit load 0.381 for these data
     with pytest.raises(dc.ConvergenceError) as err:
         dc.solve(sc, dc.LoadControl(steps=20, final=1.0, max_cuts=3,
                                     newton=NewtonOptions(max_iterations=10)))
     msg = str(err.value)
-    assert "no convergence to load factor" in msg and "arc-length" in msg
+    assert isinstance(err.value, dc.CriticalPointError)
+    assert "a limit point near load factor 0.381" in msg and "ArcLength" in msg
+    (point,) = err.value.result.critical_points
+    assert point.load_factor == pytest.approx(0.381087, rel=1e-3)
     hist = err.value.result.history
     assert len(hist) >= 1 and not err.value.result.completed
     assert 0.3 <= hist.column("load_factor")[-1] < 0.3811

@@ -273,26 +273,33 @@ class System:
         """Which dofs carry moments; the model's length and coordinate scales (round-off floor)."""
         self._rot = self._rotation_mask()
         self.has_rotations = bool(self.comm.allreduce(int(self._rot.any()), op=MPI.MAX))
-        lo, hi, big = [], [], 0.0
+        lo, hi = [], []
         for m in self.models:
             X = m.V.mesh.geometry.x[:, : m.gdim]
             if len(X):
                 lo.append(X.min(axis=0))
                 hi.append(X.max(axis=0))
-                big = max(big, float(np.abs(X).max()))
         gd = self.models[0].gdim
         lo_all, hi_all = np.empty(gd), np.empty(gd)
         self.comm.Allreduce(np.min(lo, axis=0) if lo else np.full(gd, np.inf), lo_all, op=MPI.MIN)
         self.comm.Allreduce(np.max(hi, axis=0) if hi else np.full(gd, -np.inf), hi_all, op=MPI.MAX)
         lo, hi = lo_all, hi_all
         self.length_scale = float(np.linalg.norm(hi - lo))
-        self.coordinate_scale = self.comm.allreduce(big, op=MPI.MAX)
+        self._coordinates = self._dof_coordinates()
+        self._coordinates[self._rot] = 1.0
         self.floors = {"force": 0.0, "moment": 0.0}
         self._diagonal = None
 
+    def _dof_coordinates(self) -> np.ndarray:
+        """Owned entries: the distance of each dof's node from the origin (reference)."""
+        m = self.model
+        n = self.b.getLocalSize() // m.ndof
+        X = m.V.tabulate_dof_coordinates()[:n, : m.gdim]
+        return np.repeat(np.linalg.norm(X, axis=1), m.ndof)
+
     def _update_floor(self) -> None:
         """The residual's round-off floor per field, from the tangent just assembled: an internal
-        force computed from coordinates of size c carries errors of about ε K_ii c on dof i
+        force computed from coordinates of size c_i carries errors of about ε K_ii c_i on dof i
         (ε K_ii on a rotation, angles of order one), so no residual below
         ε ‖diag(K) c‖ can be told from zero."""
         if self._diagonal is None:
@@ -301,8 +308,8 @@ class System:
         d = np.abs(self._diagonal.array)
         rot = self._rot
         eps = np.finfo(float).eps
-        sq = self.comm.allreduce(np.array([(d[~rot] @ d[~rot]) * self.coordinate_scale**2, d[rot] @ d[rot]]),
-                                 op=MPI.SUM)
+        dc = d[~rot] * self._coordinates[~rot]
+        sq = self.comm.allreduce(np.array([dc @ dc, d[rot] @ d[rot]]), op=MPI.SUM)
         self.floors = {"force": eps * math.sqrt(sq[0]), "moment": eps * math.sqrt(sq[1])}
 
     def correction_norms(self) -> dict[str, tuple[float, float]]:
@@ -572,6 +579,17 @@ class System:
         self._version += 1
         self.model.extrapolate(older[0], newer[0], factor)
 
+    def translation_difference(self, cp_a, cp_b) -> float:
+        """The largest difference of nodal translations between two configurations of
+        :meth:`checkpoint` (on every rank); the current configuration is left at ``cp_b``."""
+        values = []
+        for cp in (cp_a, cp_b):
+            self.restore(cp)
+            values.append(np.concatenate([m.translations_of(np.arange(m.V.dofmap.index_map.size_local)).ravel()
+                                          for m in self.models]))
+        local = float(np.max(np.abs(values[1] - values[0]), initial=0.0))
+        return self.comm.allreduce(local, op=MPI.MAX)
+
     def checkpoint(self):
         """The configuration and every contribution's history state (in memory)."""
         return (self.model.checkpoint(), [c.checkpoint() for c in self.contributions])
@@ -667,6 +685,15 @@ class CoupledSystem(System):
             r[:, m.translations:] = 1.0
             arrays.append(r.ravel())
         return self._owned_indicator(arrays) > 0
+
+    def _dof_coordinates(self) -> np.ndarray:
+        arrays, ones = [], []
+        for m, loc in zip(self.model.models, self.layout.local):
+            X = m.V.tabulate_dof_coordinates()[: len(loc) // m.ndof, : m.gdim]
+            arrays.append(np.repeat(np.linalg.norm(X, axis=1), m.ndof))
+            ones.append(np.ones(len(loc)))
+        # a node held by several models or ranks: the mean of the equal values
+        return self._owned_indicator(arrays) / np.maximum(self._owned_indicator(ones), 1.0)
 
     def _owned_indicator(self, arrays: Sequence[np.ndarray]) -> np.ndarray:
         """Owned entries of Σ models' local arrays (a reduction over ranks)."""

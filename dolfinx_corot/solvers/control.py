@@ -28,8 +28,8 @@ from .stability import (CriticalPoint, CriticalPointError, StabilityTracker, che
                         singular_model)
 
 STABILITY = ("auto", "on", "off")
-# a step whose Newton iterates crossed states less stable than both its ends is cut and retried;
-# a leap across a limit point is declared when it persists at 1/2**LEAP_CUTS of the nominal step
+# a step whose Newton iterates crossed states less stable than both its ends is followed again in
+# halves; a leap across a limit point is declared where it persists at 1/2**LEAP_CUTS of the step
 LEAP_CUTS = 4
 
 logger = logging.getLogger(__name__)
@@ -50,8 +50,8 @@ class LoadControl:
     systems of up to 200 000 dofs; 'on'; 'off'; see :mod:`~dolfinx_corot.solvers.stability`);
     at_critical_point: where the count changes (a bifurcation) or a step leaps across a limit
     point (its Newton iterates cross states less stable than both ends, and still do when the
-    step is cut to 1/16; the shorter retries are not failures: the history column
-    ``stability_retries`` counts them), the critical point is recorded (``result.critical_points``, with its load factor) and
+    step is followed again in halves down to 1/16 of it; the history column
+    ``stability_retries`` counts such checks), the critical point is recorded (``result.critical_points``, with its load factor) and
     'stop' (default) ends the run at the last state before it with a
     :class:`~dolfinx_corot.solvers.stability.CriticalPointError`; 'continue' goes on (with a
     warning): load control past a critical point follows an unstable or a remote branch.
@@ -131,10 +131,9 @@ class LoadControl:
         for index in range(start, len(targets)):
             target = targets[index]
             cuts = 0
-            shorter = 0   # halvings of steps whose iterates crossed less stable states (not failures)
             retried = 0
             while abs(target - lam) > 1e-14 * max(1.0, abs(target)):
-                trial = target if cuts + shorter == 0 else lam + (target - lam) / 2**(cuts + shorter)
+                trial = target if cuts == 0 else lam + (target - lam) / 2**cuts
                 cp = system.checkpoint()
                 started = run.begin()
                 if self.extrapolate and previous is not None and lam != previous[0]:
@@ -169,34 +168,34 @@ class LoadControl:
                 before, after, passed = tracker.converged(trial)
                 # past a critical point (the path already unstable) the iterates' counts say nothing
                 passed = passed and before == 0
-                if passed and after == before and cuts + shorter < self.max_cuts and \
-                        abs(trial - lam) > abs(target - (targets[index - 1] if index else 0.0)) / 2**LEAP_CUTS:
-                    # the iterates crossed less stable states than both ends: a leap across a limit
-                    # point, or an overshoot of Newton's first iterates; a shorter step tells
-                    system.restore(cp)
-                    tracker.negative = before
-                    shorter += 1
-                    retried += 1
-                    logger.info("step %d: the iterates to lambda %.6g crossed states less stable than both ends; "
-                                "retried with a step of 1/%d", run.step + 1, trial, 2**(cuts + shorter))
-                    continue
+                leap = None
                 if passed and after == before:
-                    passed = tracker.secant_unstable(cp, system.checkpoint(), lam, trial, before)
-                    if not passed:
+                    # the iterates crossed less stable states than both ends: a leap across a limit
+                    # point, or Newton's first iterates overshooting. States on the secant between
+                    # the ends tell (2D); where they cannot (rotations in 3D) or say unstable, the
+                    # step is followed again in halves (not recorded) down to 1/16 of it
+                    verdict = tracker.secant_unstable(cp, system.checkpoint(), lam, trial, before)
+                    if verdict is False:
+                        passed = False
                         tracker.count_here(trial)  # the next step's first tangent again
+                    else:
+                        passed, leap, extra_iterations = self._verify_step(run, tracker, cp, lam, trial, before)
+                        report.iterations += extra_iterations
+                        retried += 1
                 extra = {} if after is None else {"negative_eigenvalues": after, "stability_retries": retried}
                 retried = 0
-                if before is not None and after is not None and (after != before or passed):
+                if leap is not None:  # a leap within the step: its sub-step (a, b) from state cp_a
+                    a, b, cp_a = leap
+                    self._critical_point(run, tracker, cp_a, (lam, cp) if a != lam else previous, a, b, before,
+                                         after, True, stop_at=cp, trial_here=trial)
+                elif before is not None and after is not None and (after != before or passed):
                     self._critical_point(run, tracker, cp, previous, lam, trial, before, after, passed)
                 previous = (lam, cp)
                 lam = trial
                 run.record(lam, report, cuts, started, extra)
                 reached = abs(target - lam) <= 1e-14 * max(1.0, abs(target))
                 run.save({**self.describe(), "next_target": index + 1 if reached else index})
-                if shorter:
-                    shorter -= 1
-                else:
-                    cuts = max(cuts - 1, 0)
+                cuts = max(cuts - 1, 0)
         return run.result()
 
     def _limit_ahead(self, run: Run, tracker: StabilityTracker, previous, lam: float, target: float) -> None:
@@ -223,10 +222,66 @@ class LoadControl:
                  f"falls to zero. Follow the path with ArcLength (or prescribe a displacement: displacement "
                  "control).", CriticalPointError)
 
+    def _verify_step(self, run: Run, tracker: StabilityTracker, cp, lam: float, trial: float,
+                     before: int) -> tuple[bool, tuple | None, int]:
+        """The step λ = ``lam`` (state ``cp``) → ``trial`` (the current state) whose iterates crossed
+        less stable states, followed again in halves from ``cp`` (nothing recorded): (leapt, the
+        leap's sub-step (a, b, state at a) or None, Newton iterations spent). Where the halves reach
+        ``trial`` on a stable path, the step stands — at its own end state if the halves end there,
+        else at theirs (the original step had jumped to another equilibrium)."""
+        system = run.system
+        end = system.checkpoint()
+        system.restore(cp)
+        tracker.negative = before
+        status, where, iterations = self._follow(run, tracker, lam, trial, before, 1)
+        if status == "leap":
+            system.restore(end)  # the step as it was made (recorded with 'continue')
+            return True, where, iterations
+        here = system.checkpoint()
+        moved = system.translation_difference(cp, end)
+        differ = system.translation_difference(end, here)  # leaves the halves' end state
+        if differ <= 1e-3 * moved:
+            system.restore(end)
+        else:
+            logger.warning("step %d: load control had jumped to another equilibrium at lambda %.6g; the state "
+                           "reached in halves is kept (translations differ by %.3g)", run.step + 1, trial, differ)
+        tracker.negative = tracker.count_here(trial)  # the next step's first tangent, at this state
+        return False, None, iterations
+
+    def _follow(self, run: Run, tracker: StabilityTracker, lam0: float, lam1: float, before: int,
+                depth: int) -> tuple[str, tuple | None, int]:
+        """Follow λ0 → λ1 from the current state in two halves, each halved again where its
+        iterates cross less stable states, its count changes or it fails, down to 1/2**LEAP_CUTS of
+        the step: ('ok', None, iterations) at λ1, or ('leap', (a, b, state at a), iterations)."""
+        system = run.system
+        iterations = 0
+        mid = 0.5 * (lam0 + lam1)
+        for a, b in ((lam0, mid), (mid, lam1)):
+            cp_a = system.checkpoint()
+            system.before_step()
+            tracker.start_attempt()
+            report = solve_step(system, Stepper(b), self.newton)
+            iterations += report.iterations
+            flagged = not report.converged
+            if report.converged:
+                _, after, passed = tracker.converged(b)
+                flagged = passed or after != before
+            if flagged:
+                system.restore(cp_a)
+                tracker.negative = before
+                if depth >= LEAP_CUTS:
+                    return "leap", (a, b, cp_a), iterations
+                status, where, n = self._follow(run, tracker, a, b, before, depth + 1)
+                iterations += n
+                if status != "ok":
+                    return status, where, iterations
+        return "ok", None, iterations
+
     def _critical_point(self, run: Run, tracker: StabilityTracker, cp, previous, lam: float, trial: float,
-                        before: int, after: int, passed: bool) -> None:
+                        before: int, after: int, passed: bool, stop_at=None, trial_here=None) -> None:
         """Record the critical point crossed between λ = ``lam`` (state ``cp``) and ``trial`` (the
-        current state); stop there unless ``at_critical_point`` is 'continue'."""
+        current state, reached at ``trial_here`` if given); stop there (at state ``stop_at``, default
+        ``cp``) unless ``at_critical_point`` is 'continue'."""
         system = run.system
         here = system.checkpoint()
         if after != before:
@@ -263,13 +318,16 @@ class LoadControl:
         words = (f"step {run.step + 1}: a {kind} near load factor {estimate:.6g} (between {lam:.6g} and "
                  f"{trial:.6g}; {change})")
         if self.at_critical_point == "stop":
-            system.restore(cp)
+            system.restore(cp if stop_at is None else stop_at)
             tracker.negative = before
             run.fail(f"{words}: past it, load control follows an unstable or a remote branch. Follow the path "
                      "with ArcLength (or prescribe a displacement: displacement control); "
                      "LoadControl(at_critical_point='continue') goes on regardless.", CriticalPointError)
         logger.warning("%s; continuing under load control", words)
         system.restore(here)
+        # residual (reactions, monitors) and the next step's first tangent at this state again
+        system.tangent_at(trial if trial_here is None else trial_here)
+        system.take_inertia()
 
 
 class ArcLengthStepper(Stepper):

@@ -11,7 +11,7 @@ add N to N·mm). A field converges when ‖r‖ ≤ rtol·ref + atol, with ref t
 larger of ‖λ f_ext‖ and ‖f_int‖ over the field (reactions included; for
 moments at least ℓ·ref_forces, for forces at least ref_moments/ℓ, with ℓ
 the diagonal of the model's bounding box), or when it has reached the
-round-off floor of the residual after at least one correction. The floor is
+round-off floor of the residual and stopped falling there. The floor is
 estimated from the assembled tangent: internal forces computed from
 coordinates of size c carry errors of about ε K_ii c (ε K_ii on a
 rotation), so ‖r‖ ≤ ε‖diag(K)·c‖ cannot be told from zero (a stiffness
@@ -171,12 +171,13 @@ def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin:
         report.load_factor = stepper.load_factor
         return report
     scale = max(norm, ref)
+    previous = None  # the fields' residuals one iteration back
     growth = 0
     small_correction = False
     eta = None
     for it in range(1, options.max_iterations + 1):
         tol = options.rtol * ref + options.atol
-        if within_tolerance(system, options, corrected=it > 1) or small_correction:
+        if within_tolerance(system, options, previous) or small_correction:
             report.converged = True
             break
         if system.iterative:
@@ -185,6 +186,7 @@ def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin:
                 eta = forcing_term(options, norm, report.residuals[-2] if it > 1 else None,
                                    eta if it > 1 else None, tol)
                 system.set_forcing(eta)
+        fields = dict(system.fields)
         system.jacobian()
         try:
             report.increments.append(stepper.correct(system, system.correction_rhs()))
@@ -208,6 +210,7 @@ def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin:
         stepper.accept(system, s)
         report.iterations = it
         small_correction = all(d <= options.xtol * total for d, total in system.correction_norms().values())
+        previous = fields
         report.residuals.append(norm)
         system.after_iteration(report.residuals)
         logger.debug("  Newton %2d: |r| = %.3e  |dx| = %.3e", it, norm, report.increments[-1])
@@ -222,7 +225,7 @@ def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin:
                              f"(initial {report.residuals[0]:.3e})")
             break
     else:
-        report.converged = within_tolerance(system, options, corrected=True) or small_correction
+        report.converged = within_tolerance(system, options, previous) or small_correction
         if not report.converged:
             report.reason = f"no convergence in {options.max_iterations} iterations: {stall(system, options, report)}"
     if system.iterative:
@@ -232,16 +235,16 @@ def newton(system, load_factor, options: NewtonOptions = NewtonOptions(), begin:
     return report
 
 
-def within_tolerance(system, options: NewtonOptions, corrected: bool) -> bool:
+def within_tolerance(system, options: NewtonOptions, previous: dict | None) -> bool:
     """Each field of the residual (forces; moments, when the model has rotations) within
-    rtol × its own scale + atol, or, after at least one correction of the solve, below its
-    round-off floor (``system.floors``): residuals there are round-off, which no iteration
-    removes. Every test is homogeneous in its units, so a model in mm converges as it does
-    in m."""
+    rtol × its own scale + atol, or at its round-off floor (``system.floors``) where it has
+    stopped falling (above half its value one iteration back, ``previous``): residuals there
+    are round-off, which no iteration removes. Every test is homogeneous in its units, so a
+    model in mm converges as it does in m."""
     for name, (r, ref) in system.fields.items():
         if r <= options.rtol * ref + options.atol:
             continue
-        if corrected and r <= system.floors.get(name, 0.0):
+        if previous is not None and r <= system.floors.get(name, 0.0) and r > 0.5 * previous[name][0]:
             continue
         return False
     return True

@@ -380,10 +380,11 @@ class StabilityTracker:
         self.system.tangent_at(load_factor, factorize=False)
         return self.system.inertia()
 
-    def secant_unstable(self, older, newer, lam0: float, lam1: float, before: int) -> bool:
+    def secant_unstable(self, older, newer, lam0: float, lam1: float, before: int) -> bool | None:
         """Whether states on the secant between two converged states (configurations ``older``
         and ``newer``) have more negative eigenvalues than ``before``: the step crossed an
-        unstable region (snap-through), rather than Newton's iterates merely overshooting."""
+        unstable region (snap-through), rather than Newton's iterates merely overshooting;
+        None where the secant cannot be formed (rotations in 3D)."""
         system = self.system
         unstable = False
         for t in (0.25, 0.5, 0.75):
@@ -391,6 +392,7 @@ class StabilityTracker:
             try:
                 system.extrapolate(older, newer, -(1.0 - t))
             except NotImplementedError:  # no secant between rotations in 3D
+                unstable = None
                 break
             if self.count_here(lam0 + t * (lam1 - lam0)) > before:
                 unstable = True

@@ -50,8 +50,9 @@ class LoadControl:
     systems of up to 200 000 dofs; 'on'; 'off'; see :mod:`~dolfinx_corot.solvers.stability`);
     at_critical_point: where the count changes (a bifurcation) or a step leaps across a limit
     point (its Newton iterates cross states less stable than both ends, and still do when the
-    step is followed again in halves down to 1/16 of it; the history column
-    ``stability_retries`` counts such checks), the critical point is recorded (``result.critical_points``, with its load factor) and
+    step is followed again in halves down to 1/16 of it; the history columns
+    ``stability_checks`` and ``stability_iterations`` count such checks and the Newton iterations
+    they took), the critical point is recorded (``result.critical_points``, with its load factor) and
     'stop' (default) ends the run at the last state before it with a
     :class:`~dolfinx_corot.solvers.stability.CriticalPointError`; 'continue' goes on (with a
     warning): load control past a critical point follows an unstable or a remote branch.
@@ -131,7 +132,7 @@ class LoadControl:
         for index in range(start, len(targets)):
             target = targets[index]
             cuts = 0
-            retried = 0
+            retried = check_iterations = 0
             while abs(target - lam) > 1e-14 * max(1.0, abs(target)):
                 trial = target if cuts == 0 else lam + (target - lam) / 2**cuts
                 cp = system.checkpoint()
@@ -179,11 +180,12 @@ class LoadControl:
                         passed = False
                         tracker.count_here(trial)  # the next step's first tangent again
                     else:
-                        passed, leap, extra_iterations = self._verify_step(run, tracker, cp, lam, trial, before)
-                        report.iterations += extra_iterations
+                        passed, leap, checked = self._verify_step(run, tracker, cp, lam, trial, before)
                         retried += 1
-                extra = {} if after is None else {"negative_eigenvalues": after, "stability_retries": retried}
-                retried = 0
+                        check_iterations += checked
+                extra = {} if after is None else {"negative_eigenvalues": after, "stability_checks": retried,
+                                                  "stability_iterations": check_iterations}
+                retried = check_iterations = 0
                 if leap is not None:  # a leap within the step: its sub-step (a, b) from state cp_a
                     a, b, cp_a = leap
                     self._critical_point(run, tracker, cp_a, (lam, cp) if a != lam else previous, a, b, before,

@@ -255,7 +255,7 @@ class System:
         self.fields = {"force": (math.sqrt(squares[0]), ref_f)}
         if self.has_rotations:
             ref_m = max(math.sqrt(squares[3]), math.sqrt(squares[5]))
-            ell = self.length_scale
+            ell = self.element_length
             self.fields = {"force": (math.sqrt(squares[0]), max(ref_f, ref_m / ell if ell > 0.0 else 0.0)),
                            "moment": (math.sqrt(squares[1]), max(ref_m, ell * ref_f))}
         self.timings.assembly += time.perf_counter() - t
@@ -285,6 +285,20 @@ class System:
         self.comm.Allreduce(np.max(hi, axis=0) if hi else np.full(gd, -np.inf), hi_all, op=MPI.MAX)
         lo, hi = lo_all, hi_all
         self.length_scale = float(np.linalg.norm(hi - lo))
+        # the mean element side of the parts with rotations: nodal forces that balance moments M
+        # in an element of side h are of order M/h
+        total = np.zeros(2)
+        for m in self.models:
+            if m.ndof == m.translations:
+                continue
+            geometry = m.V.mesh.geometry
+            cells = geometry.dofmap.array.reshape(-1, geometry.dofmap.offsets[1])
+            n_owned = m.V.mesh.topology.index_map(m.V.mesh.topology.dim).size_local
+            x = geometry.x[cells[:n_owned]]
+            sides = np.linalg.norm(x - np.roll(x, 1, axis=1), axis=2)
+            total += (sides.sum(), sides.size)
+        total = self.comm.allreduce(total, op=MPI.SUM)
+        self.element_length = float(total[0] / total[1]) if total[1] else self.length_scale
         self._coordinates = self._dof_coordinates()
         self._coordinates[self._rot] = 1.0
         self.floors = {"force": 0.0, "moment": 0.0}

@@ -9,8 +9,9 @@ on the rotations — so that the test is homogeneous in each field's units
 and a model in mm converges as the same model in m (a single norm would
 add N to N·mm). A field converges when ‖r‖ ≤ rtol·ref + atol, with ref the
 larger of ‖λ f_ext‖ and ‖f_int‖ over the field (reactions included; for
-moments at least ℓ·ref_forces, for forces at least ref_moments/ℓ, with ℓ
-the diagonal of the model's bounding box), or when it has reached the
+moments at least h·ref_forces, for forces at least ref_moments/h, with h
+the mean element side of the parts with rotations: the nodal forces that
+balance a moment M in an element are of order M/h), or when it has reached the
 round-off floor of the residual and stopped falling there. The floor is
 estimated from the assembled tangent: internal forces computed from
 coordinates of size c carry errors of about ε K_ii c (ε K_ii on a

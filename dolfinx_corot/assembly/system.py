@@ -292,8 +292,10 @@ class System:
             if m.ndof == m.translations:
                 continue
             geometry = m.V.mesh.geometry
-            cells = geometry.dofmap.array.reshape(-1, geometry.dofmap.offsets[1])
             n_owned = m.V.mesh.topology.index_map(m.V.mesh.topology.dim).size_local
+            if n_owned == 0:  # a rank without cells of this part
+                continue
+            cells = geometry.dofmap.array.reshape(-1, geometry.dofmap.offsets[1])
             x = geometry.x[cells[:n_owned]]
             sides = np.linalg.norm(x - np.roll(x, 1, axis=1), axis=2)
             total += (sides.sum(), sides.size)

@@ -271,7 +271,9 @@ class LinearSolver:
         max|diag A| instead of 1, so that supports do not pose as soft modes."""
         A = self.A.convert("aij", PETSc.Mat()) if self._block else self.A
         S = A.copy()
-        S.axpy(1.0, A.transpose(PETSc.Mat()), PETSc.Mat.Structure.DIFFERENT)
+        T = A.transpose(PETSc.Mat())
+        S.axpy(1.0, T, PETSc.Mat.Structure.DIFFERENT)
+        T.destroy()
         S.scale(0.5)
         if scale_constrained is not None:
             d = S.getDiagonal()
@@ -301,7 +303,7 @@ class LinearSolver:
         ksp.setUp()
         F = ksp.getPC().getFactorMatrix()
         count = -1 if F.getMumpsInfog(28) > 0 else int(F.getMumpsInfog(12))
-        destroy(ksp, S)
+        destroy(F, ksp, S)  # (the factor's handle holds a reference of its own)
         return count
 
     def smallest_eigenvalue(self, constrained: np.ndarray) -> float:

@@ -241,13 +241,11 @@ class System:
         self.fext_total.copy(self.b)
         self.b.axpy(-1.0, self.fint)
         self._constrain_residual(load_factor)
-        rot = self._rot
         squares = np.zeros(6)
         with np.errstate(over="ignore"):  # loads beyond floating point: an infinite norm, reported
             for k, v in enumerate((self.b, self.fext_total, self.fint)):
                 a = v.array
-                squares[2 * k] = a[~rot] @ a[~rot]
-                squares[2 * k + 1] = a[rot] @ a[rot]
+                squares[2 * k: 2 * k + 2] = np.bincount(self._field, a * a, 2)
         squares = self.comm.allreduce(squares, op=MPI.SUM)
         norm = math.sqrt(squares[0] + squares[1])
         ref = max(math.sqrt(squares[2] + squares[3]), math.sqrt(squares[4] + squares[5]))
@@ -273,6 +271,7 @@ class System:
     def _fields_setup(self) -> None:
         """Which dofs carry moments; the model's length and coordinate scales (round-off floor)."""
         self._rot = self._rotation_mask()
+        self._field = self._rot.astype(np.intp)  # 0: force, 1: moment
         self.has_rotations = bool(self.comm.allreduce(int(self._rot.any()), op=MPI.MAX))
         lo, hi = [], []
         for m in self.models:
@@ -322,21 +321,15 @@ class System:
         if self._diagonal is None:
             self._diagonal = self.A.createVecLeft()
         self.A.getDiagonal(self._diagonal)
-        d = np.abs(self._diagonal.array)
-        rot = self._rot
+        dc = self._diagonal.array * self._coordinates  # (rotations: coordinate 1)
         eps = np.finfo(float).eps
-        dc = d[~rot] * self._coordinates[~rot]
-        sq = self.comm.allreduce(np.array([dc @ dc, d[rot] @ d[rot]]), op=MPI.SUM)
+        sq = self.comm.allreduce(np.bincount(self._field, dc * dc, 2), op=MPI.SUM)
         self.floors = {"force": eps * math.sqrt(sq[0]), "moment": eps * math.sqrt(sq[1])}
 
     def correction_norms(self) -> dict[str, tuple[float, float]]:
         """Per field: (‖dx‖, ‖Σ corrections of the step‖) — translations, rotations."""
-        rot = self._rot
-        sq = np.zeros(4)
-        for k, v in enumerate((self.dx, self.step_dx)):
-            a = v.array
-            sq[2 * k] = a[~rot] @ a[~rot]
-            sq[2 * k + 1] = a[rot] @ a[rot]
+        a, b = self.dx.array, self.step_dx.array
+        sq = np.concatenate([np.bincount(self._field, a * a, 2), np.bincount(self._field, b * b, 2)])
         sq = np.sqrt(self.comm.allreduce(sq, op=MPI.SUM))
         out = {"force": (sq[0], sq[2])}
         if self.has_rotations:

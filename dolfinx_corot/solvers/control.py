@@ -31,6 +31,8 @@ STABILITY = ("auto", "on", "off")
 # a step whose Newton iterates crossed states less stable than both its ends is followed again in
 # halves; a leap across a limit point is declared where it persists at 1/2**LEAP_CUTS of the step
 LEAP_CUTS = 4
+# ... when the step's increment exceeds LEAP_RATIO times its first (tangent) correction
+LEAP_RATIO = 2.0
 
 logger = logging.getLogger(__name__)
 
@@ -49,8 +51,9 @@ class LoadControl:
     ('auto': free with the LDLᵀ solver, one extra LDLᵀ factorization per step otherwise for
     systems of up to 200 000 dofs; 'on'; 'off'; see :mod:`~dolfinx_corot.solvers.stability`);
     at_critical_point: where the count changes (a bifurcation) or a step leaps across a limit
-    point (its Newton iterates cross states less stable than both ends, and still do when the
-    step is followed again in halves down to 1/16 of it; the history columns
+    point (its Newton iterates cross states less stable than both ends, it goes more than twice
+    as far as its tangent predicted, and it still does so when followed again in halves down to
+    1/16 of it; the history columns
     ``stability_checks`` and ``stability_iterations`` count such checks and the Newton iterations
     they took), the critical point is recorded (``result.critical_points``, with its load factor) and
     'stop' (default) ends the run at the last state before it with a
@@ -170,9 +173,15 @@ class LoadControl:
                 # past a critical point (the path already unstable) the iterates' counts say nothing
                 passed = passed and before == 0
                 leap = None
+                if passed and after == before and report.increments and \
+                        system.step_increment_norm() <= LEAP_RATIO * report.increments[0]:
+                    # the step ended near where its first (tangent) correction pointed: Newton's
+                    # first iterates overshot into less stable states and came back
+                    passed = False
                 if passed and after == before:
-                    # the iterates crossed less stable states than both ends: a leap across a limit
-                    # point, or Newton's first iterates overshooting. States on the secant between
+                    # the iterates crossed less stable states than both ends and the step went
+                    # far beyond its tangent prediction: a leap across a limit point, or a strongly
+                    # nonlinear step that Newton overshot. States on the secant between
                     # the ends tell (2D); where they cannot (rotations in 3D) or say unstable, the
                     # step is followed again in halves (not recorded) down to 1/16 of it
                     verdict = tracker.secant_unstable(cp, system.checkpoint(), lam, trial, before)

@@ -31,6 +31,7 @@ bench: setup
 	mpirun -n 2 $(PY) benchmarks/block3d.py --mesh 320 32 32
 	$(PY) benchmarks/contact_search.py             # 10⁴, 10⁵, 10⁶ slaves and segments
 	$(PY) benchmarks/contact_effects.py            # an idle interface's cost
+	$(PY) benchmarks/lining_soft_ground.py         # Newton iterations of contact in soft ground, three meshes
 
 # numba's on-disk cache does not see edits of inlined callees in other modules
 clean-cache:

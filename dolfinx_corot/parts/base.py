@@ -182,6 +182,11 @@ class Part:
         for g, dofs, motion in self._prescribed_values:
             g.x.array[dofs] = motion(load_factor, self.stage)
 
+    def held_blocks(self) -> np.ndarray:
+        """Local blocks (owned and ghost) of nodes that no existing element touches (staged
+        construction); none by default."""
+        return np.zeros(0, dtype=np.int32)
+
     def _fixed_blocks(self) -> np.ndarray:
         """Blocks whose non-translational dofs have no stiffness (fixed); none by default."""
         return np.zeros(0, dtype=np.int32)
@@ -197,6 +202,10 @@ class Part:
         free = self._fixed_blocks()
         for comp in range(self.translations, self.ndof):
             bcs.append(dolfinx.fem.dirichletbc(zero, free * self.ndof + comp, self.V.sub(comp)))
+        held = self.held_blocks()
+        if len(held):  # nodes of no existing element (staged construction): held where they are
+            for comp in range(self.ndof):
+                bcs.append(dolfinx.fem.dirichletbc(zero, held * self.ndof + comp, self.V.sub(comp)))
         self._prescribed_values = []
         self.lifting_bcs = []
         for entities, comp, motion in self._prescribed:

@@ -97,6 +97,12 @@ class Solid(AdditiveState, Part):
         self._body: list[tuple[str | None, np.ndarray, bool, object]] = []  # (where, b, × material ρ, amplitude)
         self._init_conditions()
         self._shifted = False
+        # staged construction (dolfinx_corot.staging): which cells exist (DG0, 1/0), the shift s of
+        # each cell's nodes at its activation (discontinuous, per cell) and the approach; None:
+        # every cell exists and the forms are those without stages
+        self.existing: dolfinx.fem.Function | None = None
+        self.activation_shift: dolfinx.fem.Function | None = None
+        self.approach = "II"
 
     # -- building -------------------------------------------------------------
     def add_region(self, where: str | None, material: Elastic):
@@ -226,6 +232,74 @@ class Solid(AdditiveState, Part):
         F = ufl.Identity(self.gdim) + grad if self._shifted else deformation_gradient(u)
         return first_piola(self.law, F, lmbda, mu)
 
+    # -- staged construction ----------------------------------------------------------
+    def _staged_integrand(self, u, v):
+        """P(F) : ∇v per cell with the cell's activation shift s (module dolfinx_corot.staging):
+        small strain, and approach I: strains of u − s on the mesh; approach II at large
+        rotations: the reference is X + s, F = (I + ∇u)(I + ∇s)⁻¹, integrated over the
+        reference (det(I + ∇s) dX, ∇_{X+s} v = ∇v (I + ∇s)⁻¹)."""
+        s = self.activation_shift
+        lmbda, mu = lame(self.E, self.nu)
+        I = ufl.Identity(self.gdim)
+        if not self.large_rotations:
+            eps = ufl.sym(ufl.grad(u - s))
+            return ufl.inner(lmbda * ufl.tr(eps) * I + 2.0 * mu * eps, ufl.grad(v))
+        if self.approach == "I":
+            return ufl.inner(first_piola(self.law, I + ufl.grad(u - s), lmbda, mu), ufl.grad(v))
+        J0 = I + ufl.grad(s)
+        J0inv = ufl.inv(J0)
+        F = ufl.dot(I + ufl.grad(u), J0inv)
+        return ufl.det(J0) * ufl.inner(first_piola(self.law, F, lmbda, mu), ufl.dot(ufl.grad(v), J0inv))
+
+    def start_staging(self, approach: str) -> None:
+        """Existence per cell from now on (all cells exist until :meth:`set_existing`)."""
+        if self._shifted:
+            raise NotImplementedError("staged construction of a solid whose reference was re-captured")
+        if self.existing is None:
+            mesh = self.V.mesh
+            self.existing = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, ("DG", 0)), name="existing")
+            self.existing.x.array[:] = 1.0
+            cell = self.V.ufl_element().cell()
+            element = ufl.VectorElement("DG", cell, self.degree)
+            self.activation_shift = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, element),
+                                                         name="activation_shift")
+            self._forms = None
+        self.approach = approach
+
+    def cells_existing(self) -> np.ndarray:
+        """(local cells, owned and ghost) whether each exists."""
+        return self.existing.x.array[self._cell_dof] > 0.5
+
+    def set_existing(self, exists: np.ndarray) -> None:
+        """Which local cells (owned and ghost) exist; cells that appear take the current
+        displacement of their nodes as their activation shift s (strain-free)."""
+        was = self.cells_existing()
+        new = np.flatnonzero(exists & ~was)
+        if len(new):
+            # s on the new cells' DG dofs = u at their nodes (same node order per cell)
+            dg = self.activation_shift.function_space.dofmap
+            cg = self.V.dofmap
+            bs = self.gdim
+            for c in new:
+                for a, b in zip(dg.cell_dofs(c), cg.cell_dofs(c)):
+                    self.activation_shift.x.array[a * bs:(a + 1) * bs] = self.state.x.array[b * bs:(b + 1) * bs]
+        self.existing.x.array[self._cell_dof] = exists.astype(float)
+
+    def held_blocks(self) -> np.ndarray:
+        if self.existing is None:
+            return np.zeros(0, dtype=np.int32)
+        exists = self.cells_existing()
+        cells = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)
+        n_blocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
+        touched = np.zeros(n_blocks, dtype=bool)
+        touched[cells[exists].ravel()] = True
+        # a node touched by an existing cell on another rank only: ask the owners (reverse, max)
+        flag = dolfinx.la.vector(self.V.dofmap.index_map)
+        flag.array[:] = touched
+        flag.scatter_reverse(dolfinx.la.ScatterMode.add)
+        flag.scatter_forward()
+        return np.flatnonzero(flag.array[:n_blocks] == 0).astype(np.int32)
+
     def _check_complete(self) -> None:
         cmap = self.tmesh.mesh.topology.index_map(self.tdim)
         missing = self.comm.allreduce(int(np.sum(self._owner_of_cell[: cmap.size_local] == "")), op=MPI.SUM)
@@ -240,7 +314,10 @@ class Solid(AdditiveState, Part):
             self._check_complete()
             u, v, du = self.state, ufl.TestFunction(self.V), ufl.TrialFunction(self.V)
             dx = ufl.dx(metadata={"quadrature_degree": self.quadrature})
-            integrand = ufl.inner(self.stress(u), self._gradient(v))
+            if self.existing is not None:
+                integrand = self.existing * self._staged_integrand(u, v)
+            else:
+                integrand = ufl.inner(self.stress(u), self._gradient(v))
             if self._shifted:
                 integrand = ufl.det(ufl.Identity(self.gdim) + ufl.grad(self.reference_shift)) * integrand
             residual = integrand * dx
@@ -275,6 +352,8 @@ class Solid(AdditiveState, Part):
                 if material_density:
                     self._check_density(where)  # a region given later may have none
                     term = self.density * term
+                if self.existing is not None:
+                    term = self.existing * term
                 terms.append((term if volume is None else volume * term) * measure)
         if not terms:
             return None

@@ -1,0 +1,116 @@
+"""Staged construction (issue 14, first part): existence of solid cells per stage, stage loads,
+strain-free activation. Reference: the layered fill of a laterally confined column, in closed form."""
+import gmsh
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import dolfinx_corot as dc
+from dolfinx_corot.io.mesh import from_gmsh
+from dolfinx_corot.staging import Stage, solve_stages
+
+comm = MPI.COMM_WORLD
+H, WIDTH, E, NU, RHO, G = 8.0, 1.0, 1.0e4, 0.25, 2.0, 10.0
+
+
+def _column(n: int):
+    """A column WIDTH × H of n layers (one quadrilateral each, shared nodes): cell groups layer1…n
+    from the bottom, line groups base and sides, point group 'z<k>' at the left node of height k·h."""
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("column")
+        h = H / n
+        left = [gmsh.model.geo.addPoint(0.0, k * h, 0.0) for k in range(n + 1)]
+        right = [gmsh.model.geo.addPoint(WIDTH, k * h, 0.0) for k in range(n + 1)]
+        base = gmsh.model.geo.addLine(left[0], right[0])
+        horizontal = [base] + [gmsh.model.geo.addLine(left[k], right[k]) for k in range(1, n + 1)]
+        lefts = [gmsh.model.geo.addLine(left[k], left[k + 1]) for k in range(n)]
+        rights = [gmsh.model.geo.addLine(right[k], right[k + 1]) for k in range(n)]
+        surfaces = []
+        for k in range(n):
+            loop = gmsh.model.geo.addCurveLoop([horizontal[k], rights[k], -horizontal[k + 1], -lefts[k]])
+            surfaces.append(gmsh.model.geo.addPlaneSurface([loop]))
+        for c in horizontal + lefts + rights:
+            gmsh.model.geo.mesh.setTransfiniteCurve(c, 2)
+        for sf in surfaces:
+            gmsh.model.geo.mesh.setTransfiniteSurface(sf)
+            gmsh.model.geo.mesh.setRecombine(2, sf)
+        gmsh.model.geo.synchronize()
+        def group(dim, tags, tag, name):
+            gmsh.model.addPhysicalGroup(dim, tags, tag)
+            gmsh.model.setPhysicalName(dim, tag, name)
+
+        for k, sf in enumerate(surfaces):
+            group(2, [sf], k + 1, f"layer{k + 1}")
+        group(1, [base], n + 1, "base")
+        group(1, lefts + rights, n + 2, "sides")
+        for k in range(1, n + 1):
+            group(0, [left[k]], n + 2 + k, f"z{k}")
+        gmsh.model.mesh.generate(2)
+    tm = from_gmsh(gmsh.model, 2, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm
+
+
+def _layered(n: int, approach: str, large: bool, rho: float = RHO):
+    tm = _column(n)
+    sc = dc.Scene(large_rotations=large, linear_solver="direct")
+    soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU, density=rho), degree=1)
+    sc.fix(soil, "base")
+    sc.fix(soil, "sides", dofs=("ux",))
+    sc.gravity(soil, (0.0, -G))
+    for k in range(1, n + 1):
+        sc.monitor(f"z{k}", soil, f"z{k}")
+    stages = [Stage(f"layer {k}", add=[(soil, f"layer{k}")], driver=dc.LoadControl(steps=1)) for k in range(1, n + 1)]
+    return solve_stages(sc, stages, approach=approach)
+
+
+@pytest.mark.parametrize("approach", ["I", "II"])
+@pytest.mark.parametrize("n", [1, 2, 8])
+def test_layered_fill_settles_as_the_discrete_closed_form(n, approach):
+    """Layer j of thickness h = H/n is placed stress-free on the column built so far and takes its
+    own weight γh in stage j (one bilinear element per layer, consistent nodal loads γh/2 on its two
+    levels). The settlement of the level z = k h counted from its placement is, at small strain,
+
+        s_k = γ h² / M · (k − ½ + k (n − k)),   M = E(1 − ν)/((1 + ν)(1 − 2ν)),
+
+    (stage k compresses layers 1 … k − 1 by γh·h/M each and layer k by ½γh·h/M; every later stage
+    compresses layers 1 … k by γh·h/M each) → γ z (H − z)/M as n → ∞: zero at the top, largest at
+    mid-height; the column loaded at once settles γ(Hz − z²/2)/M. Asserted to 1e-10 for each level
+    and stage count, with either approach (they coincide at small strain)."""
+    results = _layered(n, approach, large=False)
+    assert len(results) == n and all(r.completed for r in results)
+    gamma, h = RHO * G, H / n
+    M = E * (1 - NU) / ((1 + NU) * (1 - 2 * NU))
+    for k in range(1, n + 1):
+        # the level is held at rest until its layer appears: its displacement is its settlement
+        assert all(r.history.rows[-1][f"z{k}_uy"] == 0.0 for r in results[: k - 1])
+        settlement = results[-1].history.rows[-1][f"z{k}_uy"]
+        exact = -gamma * h**2 / M * (k - 0.5 + k * (n - k))
+        assert settlement == pytest.approx(exact, rel=1e-10, abs=1e-14)
+    if n == 8:  # mid-height settles most, the top least: γ z (H − z)/M + γ h (z − h/2)/M
+        uy = [results[-1].history.rows[-1][f"z{k}_uy"] for k in range(1, n + 1)]
+        assert min(uy) == pytest.approx(uy[n // 2 - 1]) and uy[-1] > 0.4 * min(uy)  # top: 7.5/19.5 of it
+
+
+def test_the_column_loaded_at_once_settles_as_the_bar_under_its_weight():
+    """The same column without stages, its whole weight at once: γ (H z − z²/2)/M at every level
+    (nodally exact for linear elements), the top settling most — and nothing of the staging in its
+    forms (a scene without stages pays nothing)."""
+    n = 8
+    tm = _column(n)
+    sc = dc.Scene(large_rotations=False, linear_solver="direct")
+    soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU, density=RHO), degree=1)
+    sc.fix(soil, "base")
+    sc.fix(soil, "sides", dofs=("ux",))
+    sc.gravity(soil, (0.0, -G))
+    for k in range(1, n + 1):
+        sc.monitor(f"z{k}", soil, f"z{k}")
+    row = dc.solve(sc, dc.LoadControl(steps=1)).history.rows[-1]
+    assert soil.model.existing is None
+    gamma, M = RHO * G, E * (1 - NU) / ((1 + NU) * (1 - 2 * NU))
+    for k in range(1, n + 1):
+        z = k * H / n
+        assert row[f"z{k}_uy"] == pytest.approx(-gamma * (H * z - z**2 / 2) / M, rel=1e-10)

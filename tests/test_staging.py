@@ -139,3 +139,22 @@ def test_approach_one_at_large_strain_follows_the_uniaxial_law_layer_by_layer():
                      - sum(g(gamma * h * (k - i - 0.5)) for i in range(1, k)))
         assert first[f"z{k}_uy"] == pytest.approx(exact, rel=1e-9)
         assert abs(second[f"z{k}_uy"] - exact) > 1e-3 * abs(exact) or k == 1
+
+
+def test_bad_stage_input_is_named():
+    """An unknown approach, a missing cell group and a part kind that cannot be staged yet each end
+    in a clear error before anything is solved."""
+    tm = _column(2)
+    sc = dc.Scene(large_rotations=False, linear_solver="direct")
+    soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU, density=RHO), degree=1)
+    sc.fix(soil, "base")
+    with pytest.raises(ValueError, match=r"approach = 'III' is not one of \('I', 'II'\)"):
+        solve_stages(sc, [Stage("one", add=[(soil, "layer1")])], approach="III")
+    with pytest.raises(dc.GroupNotFoundError, match="'layer9' not found"):
+        solve_stages(sc, [Stage("one", add=[(soil, "layer9")])])
+    from dolfinx_corot.io.gmsh_models import polyline
+    sc2 = dc.Scene()
+    beam = sc2.add_beam(polyline([[0.0, 0.0], [1.0, 0.0]], 2, line_name="beam"), "beam",
+                        section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(1.0e3))
+    with pytest.raises(NotImplementedError, match="beam 'beam': only solids are staged so far"):
+        solve_stages(sc2, [Stage("one", add=[(beam, "beam")])])

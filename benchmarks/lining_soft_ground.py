@@ -20,12 +20,12 @@ import argparse
 import json
 import time
 
-import gmsh
 import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
 from dolfinx_corot.io import output_dir, write_rows
+from dolfinx_corot.io.gmsh_models import graded_block_with_hole
 
 comm = MPI.COMM_WORLD
 R, H, CENTRE = 1.0, 0.2, 3.0  # lining axis radius and depth; depth of its centre
@@ -35,40 +35,7 @@ WIDTH, DEPTH = 10.0, 7.0      # soil block
 def soil_mesh(segments: int):
     """The soil block [−5, 5] × [−7, 0] with the hole (radius R + H/2, ``segments`` equal segments),
     groups soil, base, sides, surface, cavity; elements 2π(R + H/2)/segments at the hole, 0.6 far off."""
-    b = R + H / 2
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-        c = g.addPoint(0.0, -CENTRE, 0.0)
-        q = [g.addPoint(b * np.cos(a), -CENTRE + b * np.sin(a), 0.0) for a in np.pi / 2 * np.arange(4)]
-        arcs = [g.addCircleArc(q[i], c, q[(i + 1) % 4]) for i in range(4)]
-        w = WIDTH / 2
-        p = [g.addPoint(x, y, 0.0) for x, y in ((-w, -DEPTH), (w, -DEPTH), (w, 0.0), (-w, 0.0))]
-        lines = [g.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
-        s = g.addPlaneSurface([g.addCurveLoop(lines), g.addCurveLoop(arcs)])
-        for a in arcs:
-            g.mesh.setTransfiniteCurve(a, segments // 4 + 1)
-        g.synchronize()
-        f = gmsh.model.mesh.field
-        dist = f.add("Distance")
-        f.setNumbers(dist, "CurvesList", arcs)
-        th = f.add("Threshold")
-        f.setNumber(th, "InField", dist)
-        f.setNumber(th, "SizeMin", 2 * np.pi * b / segments)
-        f.setNumber(th, "SizeMax", 0.6)
-        f.setNumber(th, "DistMin", 0.3)
-        f.setNumber(th, "DistMax", 3.0)
-        f.setAsBackgroundMesh(th)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        for dim, tags, name in ((2, [s], "soil"), (1, [lines[0]], "base"), (1, [lines[1], lines[3]], "sides"),
-                                (1, [lines[2]], "surface"), (1, arcs, "cavity")):
-            gmsh.model.setPhysicalName(dim, gmsh.model.addPhysicalGroup(dim, tags), name)
-        gmsh.model.mesh.generate(2)
-    tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
-    return tm
+    return graded_block_with_hole(WIDTH, DEPTH, CENTRE, R + H / 2, segments, 0.6, comm=comm)
 
 
 def lining_mesh(n: int):

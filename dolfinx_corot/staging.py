@@ -56,42 +56,28 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
     staged = {}
     for ref, group in list(initial) + [item for st in stages for item in st.add]:
         model = ref.model
-        if not getattr(model, "continuum", False):
-            raise NotImplementedError(f"solve_stages: {ref.kind} '{ref.name}': only solids are staged so far "
-                                      "(structures, contact and excavation: issue 14, next part)")
         if id(model) not in staged:
-            model.start_staging(approach)
-            exists = np.zeros(len(model.cells_existing()), dtype=bool)
-            staged[id(model)] = (model, exists)
+            try:
+                model.start_staging(approach)
+            except NotImplementedError as err:  # parts that cannot be staged yet
+                raise NotImplementedError(f"solve_stages: {ref.kind} '{ref.name}': {err}") from None
+            staged[id(model)] = (model, np.zeros(len(model.cells_existing()), dtype=bool))
         model.tmesh.cells(group)  # fails early for a missing group
     for ref, group in initial:
-        model, exists = staged[id(ref.model)]
-        exists[ref.model.tmesh.cells(group)] = True
+        staged[id(ref.model)][1][ref.model.tmesh.cells(group)] = True
     for model, exists in staged.values():
-        model.existing.x.array[:] = 0.0
         model.set_existing(exists)
-    previous = None  # F_{k-1}
+    previous = None  # F_{k-1}, owned entries
     results = []
     for stage in stages:
         for ref, group in stage.add:
-            model, exists = staged[id(ref.model)]
-            exists[ref.model.tmesh.cells(group)] = True
+            staged[id(ref.model)][1][ref.model.tmesh.cells(group)] = True
         for model, exists in staged.values():
             model.set_existing(exists)
         system = make_system(scene.model, solver=scene.linear_solver, contributions=scene.contributions())
         try:
-            target = system.fext.copy()
-            if previous is not None:
-                system.fext.axpy(-1.0, previous)
-                system.amplitude_loads.append((_one, previous))
+            previous = system.ramp_loads_from(previous)
             results.append(solve(scene, stage.driver, system=system))
-            if previous is not None:
-                system.amplitude_loads.pop()
-            previous = target
         finally:
             system.destroy()
     return results
-
-
-def _one(load_factor: float) -> float:
-    return 1.0

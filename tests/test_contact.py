@@ -4,7 +4,9 @@ import pytest
 from mpi4py import MPI
 
 import dolfinx_corot as dc
+from dolfinx_corot.io.gmsh_models import graded_block_with_hole
 from dolfinx_corot.io.mesh import rectangles
+from fd import tangent_and_fd
 
 comm = MPI.COMM_WORLD
 E, NU, P = 1.0, 0.3, 0.01  # B5_contact_patch_test.json (plane strain)
@@ -174,24 +176,9 @@ def test_assembled_contact_tangent_matches_finite_differences(symmetric, smooth)
     u[:, 1] = np.where(X[:, 1] > 1.0 - 1e-12, -0.02, 0.0) + 0.004 * X[:, 0] * (X[:, 1] > 1 - 1e-12)
     u[:, 0] = 0.01 * X[:, 1] ** 2
     u += rng.uniform(-1e-3, 1e-3, u.shape) * (X[:, 0:1] > 1e-12)
-    x0 = model.state.x.array.copy()
-    system.residual(1.0)
-    system.jacobian()
-    K = system.A.convert("dense").getDenseArray().copy()
-    n = len(x0)
-    Kfd = np.zeros((n, n))
-    h = 1e-7
-    for j in range(n):
-        r = []
-        for sign in (1, -1):
-            model.state.x.array[:] = x0
-            model.state.x.array[j] += sign * h
-            system.residual(1.0)
-            r.append(system.b.array.copy())
-        Kfd[:, j] = -(r[0] - r[1]) / (2 * h)
-    model.state.x.array[:] = x0
+    K, Kfd = tangent_and_fd(system, model.state.x.array, 1.0)
     fixed = np.concatenate([bc.dof_indices()[0] for bc in system.bcs])
-    free = np.setdiff1d(np.arange(n), fixed)
+    free = np.setdiff1d(np.arange(len(K)), fixed)
     sub = np.ix_(free, free)
     assert comm.allreduce(int(sc.interfaces[0].active.max()), op=MPI.MAX) >= 0
     assert np.abs(K[sub] - Kfd[sub]).max() < 1e-6 * np.abs(K[sub]).max()
@@ -550,39 +537,9 @@ def _lining_in_soft_ground(k):
     """The scene of benchmarks/lining_soft_ground.py on mesh k: a lining (ring of 24k beams, axis
     radius 1, depth 0.2) in a hole (32k segments) of a soft soil block 10 × 7 that settles under its
     own weight and a surcharge, carrying the lining down with it (symmetric augmented Lagrangian)."""
-    import gmsh
-
     R, H, centre = 1.0, 0.2, 3.0
     b = R + H / 2
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-        c = g.addPoint(0.0, -centre, 0.0)
-        q = [g.addPoint(b * np.cos(a), -centre + b * np.sin(a), 0.0) for a in np.pi / 2 * np.arange(4)]
-        arcs = [g.addCircleArc(q[i], c, q[(i + 1) % 4]) for i in range(4)]
-        p = [g.addPoint(x, y, 0.0) for x, y in ((-5.0, -7.0), (5.0, -7.0), (5.0, 0.0), (-5.0, 0.0))]
-        lines = [g.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
-        s = g.addPlaneSurface([g.addCurveLoop(lines), g.addCurveLoop(arcs)])
-        for a in arcs:
-            g.mesh.setTransfiniteCurve(a, 8 * k + 1)
-        g.synchronize()
-        f = gmsh.model.mesh.field
-        dist = f.add("Distance")
-        f.setNumbers(dist, "CurvesList", arcs)
-        th = f.add("Threshold")
-        for key, value in (("InField", dist), ("SizeMin", 2 * np.pi * b / (32 * k)), ("SizeMax", 0.6),
-                           ("DistMin", 0.3), ("DistMax", 3.0)):
-            f.setNumber(th, key, value)
-        f.setAsBackgroundMesh(th)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        for dim, tags, name in ((2, [s], "soil"), (1, [lines[0]], "base"), (1, [lines[1], lines[3]], "sides"),
-                                (1, [lines[2]], "surface"), (1, arcs, "cavity")):
-            gmsh.model.setPhysicalName(dim, gmsh.model.addPhysicalGroup(dim, tags), name)
-        gmsh.model.mesh.generate(2)
-    soil_mesh = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
+    soil_mesh = graded_block_with_hole(10.0, 7.0, centre, b, 32 * k, 0.6, comm=comm)
     n = 24 * k
     a = 2 * np.pi * np.arange(n) / n - np.pi / 2
     ring = dc.io.mesh.from_arrays(np.column_stack([R * np.cos(a), -centre + R * np.sin(a)]),

@@ -7,7 +7,9 @@ from mpi4py import MPI
 
 import dolfinx_corot as dc
 from dolfinx_corot.io.mesh import from_gmsh
+from dolfinx_corot.assembly import make_system
 from dolfinx_corot.staging import Stage, solve_stages
+from fd import tangent_and_fd
 
 comm = MPI.COMM_WORLD
 H, WIDTH, E, NU, RHO, G = 8.0, 1.0, 1.0e4, 0.25, 2.0, 10.0
@@ -54,15 +56,20 @@ def _column(n: int):
     return tm
 
 
-def _layered(n: int, approach: str, large: bool, modulus: float = E):
-    tm = _column(n)
+def _column_scene(n: int, large: bool, modulus: float = E):
+    """The column under its weight (base clamped, sides on rollers), each level monitored."""
     sc = dc.Scene(large_rotations=large, linear_solver="direct")
-    soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(modulus, NU, density=RHO), degree=1)
+    soil = sc.add_solid(_column(n), material=dc.SaintVenantKirchhoff(modulus, NU, density=RHO), degree=1)
     sc.fix(soil, "base")
     sc.fix(soil, "sides", dofs=("ux",))
     sc.gravity(soil, (0.0, -G))
     for k in range(1, n + 1):
         sc.monitor(f"z{k}", soil, f"z{k}")
+    return sc, soil
+
+
+def _layered(n: int, approach: str, large: bool, modulus: float = E):
+    sc, soil = _column_scene(n, large, modulus)
     stages = [Stage(f"layer {k}", add=[(soil, f"layer{k}")], driver=dc.LoadControl(steps=1)) for k in range(1, n + 1)]
     return solve_stages(sc, stages, approach=approach)
 
@@ -100,14 +107,7 @@ def test_the_column_loaded_at_once_settles_as_the_bar_under_its_weight():
     (nodally exact for linear elements), the top settling most — and nothing of the staging in its
     forms (a scene without stages pays nothing)."""
     n = 8
-    tm = _column(n)
-    sc = dc.Scene(large_rotations=False, linear_solver="direct")
-    soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU, density=RHO), degree=1)
-    sc.fix(soil, "base")
-    sc.fix(soil, "sides", dofs=("ux",))
-    sc.gravity(soil, (0.0, -G))
-    for k in range(1, n + 1):
-        sc.monitor(f"z{k}", soil, f"z{k}")
+    sc, soil = _column_scene(n, large=False)
     row = dc.solve(sc, dc.LoadControl(steps=1)).history.rows[-1]
     assert soil.model.existing is None
     gamma, M = RHO * G, E * (1 - NU) / ((1 + NU) * (1 - 2 * NU))
@@ -144,10 +144,7 @@ def test_approach_one_at_large_strain_follows_the_uniaxial_law_layer_by_layer():
 def test_bad_stage_input_is_named():
     """An unknown approach, a missing cell group and a part kind that cannot be staged yet each end
     in a clear error before anything is solved."""
-    tm = _column(2)
-    sc = dc.Scene(large_rotations=False, linear_solver="direct")
-    soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU, density=RHO), degree=1)
-    sc.fix(soil, "base")
+    sc, soil = _column_scene(2, large=False)
     with pytest.raises(ValueError, match=r"approach = 'III' is not one of \('I', 'II'\)"):
         solve_stages(sc, [Stage("one", add=[(soil, "layer1")])], approach="III")
     with pytest.raises(dc.GroupNotFoundError, match="'layer9' not found"):
@@ -156,5 +153,30 @@ def test_bad_stage_input_is_named():
     sc2 = dc.Scene()
     beam = sc2.add_beam(polyline([[0.0, 0.0], [1.0, 0.0]], 2, line_name="beam"), "beam",
                         section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(1.0e3))
-    with pytest.raises(NotImplementedError, match="beam 'beam': only solids are staged so far"):
+    with pytest.raises(NotImplementedError, match="solve_stages: beam 'beam': staged construction: structural "
+                                                  "parts are not staged yet, only solids"):
         solve_stages(sc2, [Stage("one", add=[(beam, "beam")])])
+
+
+@pytest.mark.skipif(comm.size > 1, reason="dense finite differences of the assembled system: serial")
+@pytest.mark.parametrize("approach", ["I", "II"])
+def test_staged_tangent_matches_finite_differences(approach):
+    """The tangent of a staged column at large strain — the top layer activated on the settled one,
+    its shift s ≠ 0 (approach II: F = (I + ∇u)(I + ∇s)⁻¹ over X + s) — against central differences
+    of the residual at a perturbed state, free dofs (1e-6 of its largest entry)."""
+    sc, soil = _column_scene(2, large=True, modulus=1500.0)
+    solve_stages(sc, [Stage(f"layer {k}", add=[(soil, f"layer{k}")]) for k in (1, 2)], approach=approach)
+    model = soil.model
+    assert np.abs(model.activation_shift.x.array).max() > 0.05  # the second layer's bottom had settled
+    system = make_system(sc.model, solver="direct")
+    try:
+        rng = np.random.default_rng(5)
+        model.state.x.array[:] += rng.uniform(-0.02, 0.02, model.state.x.array.shape)
+        K, Kfd = tangent_and_fd(system, model.state.x.array, 1.0)
+        fixed = np.concatenate([bc.dof_indices()[0] for bc in system.bcs])
+    finally:
+        system.destroy()
+    free = np.setdiff1d(np.arange(len(K)), fixed)  # (constrained columns are eliminated from K)
+    K, Kfd = K[np.ix_(free, free)], Kfd[np.ix_(free, free)]
+    assert np.abs(K).max() > 100.0
+    assert np.abs(K - Kfd).max() < 1e-6 * np.abs(K).max()

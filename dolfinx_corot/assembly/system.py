@@ -496,6 +496,18 @@ class System:
         self.fext.copy(out)
         dolfinx.fem.petsc.set_bc(out, self.bcs, None, 0.0)
 
+    def ramp_loads_from(self, previous: np.ndarray | None) -> np.ndarray:
+        """Stage loads: f_ext(λ) = F_prev + λ (F − F_prev), with F the external force assembled
+        for this system and F_prev (owned entries) that of the stage before (None: F_prev = 0).
+        Returns F (owned entries), the next stage's F_prev."""
+        target = self.fext.array.copy()
+        if previous is not None:
+            self.fext.array[:] -= previous
+            held = self.new_vector()
+            held.array[:] = previous
+            self.amplitude_loads.append((_constant_one, held))  # destroyed with the system
+        return target
+
     def new_vector(self) -> PETSc.Vec:
         """A vector laid out like the solution (ghosted)."""
         return petsc.duplicate(self.b)
@@ -843,3 +855,7 @@ def make_system(model, solver: str = "auto", contributions: Sequence[Contributio
                                   "parts use the direct solver")
     cls = CoupledSystem if model.coupled else System
     return cls(model, solver=solver, contributions=contributions, **kwargs)
+
+
+def _constant_one(load_factor: float) -> float:
+    return 1.0

@@ -140,6 +140,54 @@ def block_with_hole(width: float, height: float, depth: float, radius: float, si
             gmsh.finalize()
 
 
+def graded_block_with_hole(width: float, height: float, depth: float, radius: float, segments: int,
+                           size_far: float, grading: tuple[float, float] = (0.3, 3.0),
+                           comm: MPI.Comm = MPI.COMM_WORLD) -> TaggedMesh:
+    """A ground block [−width/2, width/2] × [−height, 0] with a circular hole of ``radius`` whose
+    centre lies ``depth`` below the surface (``segments`` equal segments, a multiple of 4), meshed
+    with linear triangles of the segments' length at the hole growing to ``size_far`` between the
+    distances ``grading`` from it (gmsh's Distance + Threshold fields). Groups: 'soil' (cells),
+    'base', 'sides', 'surface' (y = 0) and 'cavity'."""
+    import gmsh
+
+    if not (0.0 < radius < depth < height and 2.0 * radius < width) or segments % 4:
+        raise ValueError(f"graded_block_with_hole: the hole (radius {radius}, centre {depth} deep) must lie inside "
+                         f"the block {width} × {height}, and segments = {segments} be a multiple of 4")
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        g = gmsh.model.geo
+        c = g.addPoint(0.0, -depth, 0.0)
+        q = [g.addPoint(radius * np.cos(a), -depth + radius * np.sin(a), 0.0) for a in np.pi / 2 * np.arange(4)]
+        arcs = [g.addCircleArc(q[i], c, q[(i + 1) % 4]) for i in range(4)]
+        w = width / 2
+        p = [g.addPoint(x, y, 0.0) for x, y in ((-w, -height), (w, -height), (w, 0.0), (-w, 0.0))]
+        lines = [g.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
+        s = g.addPlaneSurface([g.addCurveLoop(lines), g.addCurveLoop(arcs)])
+        for a in arcs:
+            g.mesh.setTransfiniteCurve(a, segments // 4 + 1)
+        g.synchronize()
+        f = gmsh.model.mesh.field
+        dist = f.add("Distance")
+        f.setNumbers(dist, "CurvesList", arcs)
+        th = f.add("Threshold")
+        for key, value in (("InField", dist), ("SizeMin", 2 * np.pi * radius / segments), ("SizeMax", size_far),
+                           ("DistMin", grading[0]), ("DistMax", grading[1])):
+            f.setNumber(th, key, value)
+        f.setAsBackgroundMesh(th)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        for dim, tags, name in ((2, [s], "soil"), (1, [lines[0]], "base"), (1, [lines[1], lines[3]], "sides"),
+                                (1, [lines[2]], "surface"), (1, arcs, "cavity")):
+            gmsh.model.setPhysicalName(dim, gmsh.model.addPhysicalGroup(dim, tags), name)
+        gmsh.model.mesh.generate(2)
+    from .mesh import from_gmsh
+
+    tm = from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=2, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm
+
+
 def ring(radius: float, elements: int, centre=(0.0, 0.0), name: str = "ring",
          comm: MPI.Comm = MPI.COMM_WORLD) -> TaggedMesh:
     """A closed circle of ``elements`` straight 2D line elements through nodes on ``radius`` about

@@ -182,6 +182,12 @@ class Part:
         for g, dofs, motion in self._prescribed_values:
             g.x.array[dofs] = motion(load_factor, self.stage)
 
+    def start_staging(self, approach: str) -> None:
+        """Take part in staged construction (:mod:`dolfinx_corot.staging`): existence per element
+        from now on. Parts that cannot be staged yet say so."""
+        raise NotImplementedError(f"staged construction: {self.kind_name} parts are not staged yet, only solids "
+                                  "(structures, contact and excavation in stages: issue 14, next part)")
+
     def held_blocks(self) -> np.ndarray:
         """Local blocks (owned and ghost) of nodes that no existing element touches (staged
         construction); none by default."""

@@ -252,13 +252,12 @@ class Solid(AdditiveState, Part):
         return ufl.det(J0) * ufl.inner(first_piola(self.law, F, lmbda, mu), ufl.dot(ufl.grad(v), J0inv))
 
     def start_staging(self, approach: str) -> None:
-        """Existence per cell from now on (all cells exist until :meth:`set_existing`)."""
+        """Existence per cell from now on (no cell exists until :meth:`set_existing`)."""
         if self._shifted:
             raise NotImplementedError("staged construction of a solid whose reference was re-captured")
         if self.existing is None:
             mesh = self.V.mesh
             self.existing = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, ("DG", 0)), name="existing")
-            self.existing.x.array[:] = 1.0
             cell = self.V.ufl_element().cell()
             element = ufl.VectorElement("DG", cell, self.degree)
             self.activation_shift = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, element),
@@ -273,16 +272,13 @@ class Solid(AdditiveState, Part):
     def set_existing(self, exists: np.ndarray) -> None:
         """Which local cells (owned and ghost) exist; cells that appear take the current
         displacement of their nodes as their activation shift s (strain-free)."""
-        was = self.cells_existing()
-        new = np.flatnonzero(exists & ~was)
-        if len(new):
-            # s on the new cells' DG dofs = u at their nodes (same node order per cell)
-            dg = self.activation_shift.function_space.dofmap
-            cg = self.V.dofmap
-            bs = self.gdim
-            for c in new:
-                for a, b in zip(dg.cell_dofs(c), cg.cell_dofs(c)):
-                    self.activation_shift.x.array[a * bs:(a + 1) * bs] = self.state.x.array[b * bs:(b + 1) * bs]
+        new = exists & ~self.cells_existing()
+        if new.any():
+            # s on the new cells' DG dofs = u at their nodes (the same node order per cell)
+            n = self.nodes_per_cell
+            dg = self.activation_shift.function_space.dofmap.list.array.reshape(-1, n)[new].ravel()
+            cg = self.V.dofmap.list.array.reshape(-1, n)[new].ravel()
+            self.activation_shift.x.array.reshape(-1, self.gdim)[dg] = self.state.x.array.reshape(-1, self.gdim)[cg]
         self.existing.x.array[self._cell_dof] = exists.astype(float)
 
     def held_blocks(self) -> np.ndarray:

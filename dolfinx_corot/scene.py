@@ -412,6 +412,12 @@ class Scene:
             self._coupled = Coupled(list(self._models.values()))
         return self._coupled
 
+    def contacts_holding(self, model) -> list[str]:
+        """Names of the contact interfaces with a side on ``model`` (a part model): what may hold
+        it besides its supports."""
+        return [itf.name for itf in self.interfaces
+                if itf.slave_spec[0].model is model or itf.master_spec[0].model is model]
+
     def contributions(self) -> list:
         """The contributions the scene adds to its parts' system (contact, when it has interfaces;
         the stabilisation, when a part is stabilised): a scene without them pays nothing for them."""

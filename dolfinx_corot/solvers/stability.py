@@ -163,14 +163,12 @@ def _describe_part(model, X: np.ndarray, v: np.ndarray, scene) -> str:
 def _contact_note(model, scene) -> str:
     if scene is None:
         return ""
-    names = [itf.name for itf in getattr(scene, "interfaces", [])
-             if itf.slave_spec[0].model is model or itf.master_spec[0].model is model]
+    names = scene.contacts_holding(model)
     if not names:
         return " (no support holds it)"
-    how = ("; or stabilise it until contact closes (scene.stabilise)" if hasattr(scene, "stabilise") else "")
     return (f"; it is held only by contact ({', '.join(repr(n) for n in names)}), which carries nothing in "
             "this state (an initial gap, or a frictionless body free to slide or spin): support it, close the "
-            f"gap{how}")
+            "gap; or stabilise it until contact closes (scene.stabilise)")
 
 
 def _canonical_modes(model) -> tuple[list[np.ndarray], np.ndarray]:

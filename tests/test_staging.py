@@ -142,7 +142,7 @@ def test_approach_one_at_large_strain_follows_the_uniaxial_law_layer_by_layer():
 
 
 def test_bad_stage_input_is_named():
-    """An unknown approach, a missing cell group and a part kind that cannot be staged yet each end
+    """An unknown approach, a missing cell group and a part kind that cannot be staged yet (3D beams) each end
     in a clear error before anything is solved."""
     sc, soil = _column_scene(2, large=False)
     with pytest.raises(ValueError, match=r"approach = 'III' is not one of \('I', 'II'\)"):
@@ -151,10 +151,10 @@ def test_bad_stage_input_is_named():
         solve_stages(sc, [Stage("one", add=[(soil, "layer9")])])
     from dolfinx_corot.io.gmsh_models import polyline
     sc2 = dc.Scene()
-    beam = sc2.add_beam(polyline([[0.0, 0.0], [1.0, 0.0]], 2, line_name="beam"), "beam",
-                        section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(1.0e3))
-    with pytest.raises(NotImplementedError, match="solve_stages: beam 'beam': staged construction: structural "
-                                                  "parts are not staged yet, only solids"):
+    beam = sc2.add_beam(polyline([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], 2, line_name="beam", gdim=3), "beam",
+                        section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(1.0e3), orientation=(0.0, 0.0, 1.0))
+    with pytest.raises(NotImplementedError, match="solve_stages: beam 'beam': staged construction: Frame3D "
+                                                  "parts are not staged yet, only solids and 2D beams and bars"):
         solve_stages(sc2, [Stage("one", add=[(beam, "beam")])])
 
 
@@ -177,6 +177,241 @@ def test_staged_tangent_matches_finite_differences(approach):
     finally:
         system.destroy()
     free = np.setdiff1d(np.arange(len(K)), fixed)  # (constrained columns are eliminated from K)
+    K, Kfd = K[np.ix_(free, free)], Kfd[np.ix_(free, free)]
+    assert np.abs(K).max() > 100.0
+    assert np.abs(K - Kfd).max() < 1e-6 * np.abs(K).max()
+
+
+# -- excavation -------------------------------------------------------------------------------
+WG, HG, WP, DP = 6.0, 4.0, 2.0, 1.0  # ground width and height, pit width and depth (pit at x = 0, the axis)
+
+
+def _ground(with_pit: bool, n: int = 2, beams: bool = False):
+    """Ground WG × HG of quadrilaterals (n per metre): cell groups 'ground' and, if ``with_pit``,
+    'pit' = [0, WP] × [HG − DP, HG]; line groups 'base', 'sides'; point groups 'floor' at (0, HG − DP)
+    and, with the pit, 'top' at (0, HG). ``beams``: the pit is ground and the top surface carries
+    the line groups 'beam_left' (x < WP) and 'beam_right' (read for beams too, dim = 1)."""
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("ground")
+        geo = gmsh.model.geo
+        xs, ys = [0.0, WP, WG], [0.0, HG - DP, HG]
+        pts = {(i, j): geo.addPoint(xs[i], ys[j], 0.0) for i in range(3) for j in range(3)}
+        hor = {(i, j): geo.addLine(pts[i, j], pts[i + 1, j]) for i in range(2) for j in range(3)}
+        ver = {(i, j): geo.addLine(pts[i, j], pts[i, j + 1]) for i in range(3) for j in range(2)}
+        surf = {}
+        for i in range(2):
+            for j in range(2):
+                if (i, j) == (0, 1) and not with_pit:
+                    continue
+                loop = geo.addCurveLoop([hor[i, j], ver[i + 1, j], -hor[i, j + 1], -ver[i, j]])
+                surf[i, j] = geo.addPlaneSurface([loop])
+        for (i, j), c in hor.items():
+            geo.mesh.setTransfiniteCurve(c, int(round(n * (xs[i + 1] - xs[i]))) + 1)
+        for (i, j), c in ver.items():
+            geo.mesh.setTransfiniteCurve(c, int(round(n * (ys[j + 1] - ys[j]))) + 1)
+        for sf in surf.values():
+            geo.mesh.setTransfiniteSurface(sf)
+            geo.mesh.setRecombine(2, sf)
+        geo.synchronize()
+
+        def group(dim, tags, tag, name):
+            gmsh.model.addPhysicalGroup(dim, tags, tag)
+            gmsh.model.setPhysicalName(dim, tag, name)
+
+        group(2, [s for k, s in surf.items() if beams or k != (0, 1)], 1, "ground")
+        if with_pit and not beams:
+            group(2, [surf[0, 1]], 2, "pit")
+        group(1, [hor[0, 0], hor[1, 0]], 3, "base")
+        group(1, [ver[0, 0], ver[0, 1], ver[2, 0], ver[2, 1]] if with_pit else [ver[0, 0], ver[2, 0], ver[2, 1]],
+              4, "sides")
+        if beams:  # the top surface, left of x = WP (loaded) and right of it
+            group(1, [hor[0, 2]], 7, "beam_left")
+            group(1, [hor[1, 2]], 8, "beam_right")
+        group(0, [pts[0, 1]], 5, "floor")
+        if with_pit and not beams:
+            group(0, [pts[0, 2]], 6, "top")
+        gmsh.model.mesh.generate(2)
+    tm = from_gmsh(gmsh.model, 2, comm=comm)
+    lines = from_gmsh(gmsh.model, 2, comm=comm, dim=1) if beams else None
+    if comm.rank == 0:
+        gmsh.finalize()
+    return (tm, lines) if beams else tm
+
+
+def _ground_scene(with_pit: bool):
+    sc = dc.Scene(large_rotations=False, linear_solver="direct")
+    soil = sc.add_solid(_ground(with_pit), material=dc.Elastic(E, NU, density=RHO), degree=1)
+    sc.fix(soil, "base")
+    sc.fix(soil, "sides", dofs=("ux",))
+    sc.gravity(soil, (0.0, -G))
+    sc.monitor("floor", soil, "floor")
+    if with_pit:
+        sc.monitor("top", soil, "top")
+    return sc, soil
+
+
+def _by_position(points: np.ndarray, values: np.ndarray) -> dict:
+    """{rounded position: value} over all ranks (owned entries given)."""
+    pts = np.concatenate(comm.allgather(np.round(points, 9)))
+    vals = np.concatenate(comm.allgather(values))
+    return {tuple(p): v for p, v in zip(pts, vals)}
+
+
+def _nodal(soil) -> dict:
+    m = soil.model
+    n = m.V.dofmap.index_map.size_local
+    return _by_position(m.V.tabulate_dof_coordinates()[:n, :2], m.state.x.array.reshape(-1, 2)[:n])
+
+
+def _stresses(soil) -> dict:
+    m = soil.model
+    mesh = m.V.mesh
+    n = mesh.topology.index_map(2).size_local
+    x = mesh.geometry.x[:, :2]
+    centres = np.array([x[mesh.geometry.dofmap.links(c)].mean(axis=0) for c in range(n)])
+    return _by_position(centres, m.cell_stress())
+
+
+def test_excavation_releases_the_pit_gradually_to_the_state_of_the_excavated_ground():
+    """Ground under gravity (a geostatic stage: displacements discarded, stresses kept), then the
+    pit excavated over two steps. Small strain: the final stresses in the remaining ground equal
+    those of one gravity analysis of the ground without the pit, cell by cell (1e-9 of the largest),
+    and the displacement since the geostatic stage equals that analysis' displacement minus the
+    geostatic one, node by node. The pit's forces on the ground are released in proportion to λ:
+    halfway the floor has heaved half of its final heave."""
+    sc, soil = _ground_scene(with_pit=True)
+    results = solve_stages(sc, [Stage("geostatic", add=[(soil, "ground"), (soil, "pit")], reset_displacements=True),
+                                Stage("excavation", remove=[(soil, "pit")], driver=dc.LoadControl(steps=2))],
+                           approach="I")
+    assert results[0].history.rows[-1]["floor_uy"] < 0.0
+    # the geostatic displacements, from a plain gravity run on the full ground
+    full, full_soil = _ground_scene(with_pit=True)
+    dc.solve(full, dc.LoadControl(steps=1))
+    u_geo = _nodal(full_soil)
+    cut, cut_soil = _ground_scene(with_pit=False)
+    dc.solve(cut, dc.LoadControl(steps=1))
+    u_cut, s_cut = _nodal(cut_soil), _stresses(cut_soil)
+    # the excavation stage, from the staged run
+    rows = results[1].history.rows
+    heave = rows[-1]["floor_uy"]
+    assert heave > 0.0 and rows[0]["floor_uy"] == pytest.approx(0.5 * heave, rel=1e-9)
+    u_staged, s_staged = _nodal(soil), _stresses(soil)
+    scale_u = max(abs(v).max() for v in u_cut.values())
+    for p, u in u_cut.items():
+        assert np.abs(u_staged[p] - (u - u_geo[p])).max() < 1e-9 * scale_u
+    scale_s = max(abs(v).max() for v in s_cut.values())
+    for p, s in s_cut.items():
+        assert np.abs(s_staged[p] - s).max() < 1e-9 * scale_s
+    pit_cells = [p for p in s_staged if p not in s_cut]
+    assert len(pit_cells) == 8 and all(np.abs(s_staged[p]).max() == 0.0 for p in pit_cells)
+
+
+def test_nodes_left_by_excavated_cells_stay_where_they_are():
+    """Without a geostatic reset, the nodes that only the pit's cells touched (its top, on the
+    axis) keep the displacement they had when the pit was removed; the floor heaves."""
+    sc, soil = _ground_scene(with_pit=True)
+    results = solve_stages(sc, [Stage("gravity", add=[(soil, "ground"), (soil, "pit")]),
+                                Stage("excavation", remove=[(soil, "pit")])])
+    before, after = results[0].history.rows[-1], results[1].history.rows[-1]
+    assert before["top_uy"] < 0.0 and after["top_uy"] == before["top_uy"]
+    assert after["floor_uy"] > before["floor_uy"]
+
+
+def test_removing_what_does_not_exist_is_named():
+    sc, soil = _ground_scene(with_pit=True)
+    with pytest.raises(ValueError, match="stage 'dig' removes 'pit' of solid .* which does not exist"):
+        solve_stages(sc, [Stage("fill", add=[(soil, "ground")]), Stage("dig", remove=[(soil, "pit")])])
+
+
+# -- structures added in stages ------------------------------------------------------------------
+Q_TOP, E_BEAM = 150.0, 1.0e6  # surcharge on the left of the surface; beam modulus (section 0.3 × 0.3)
+
+
+def _ground_and_beam(large: bool, with_beam: bool = True):
+    """The ground (its pit filled), a surcharge Q_TOP on its surface left of x = WP, and a beam along
+    the whole surface sharing the ground's nodes (groups beam_left, beam_right)."""
+    tm, lines = _ground(with_pit=True, beams=True)
+    sc = dc.Scene(large_rotations=large, linear_solver="direct")
+    material = dc.SaintVenantKirchhoff(E, NU) if large else dc.Elastic(E, NU)
+    soil = sc.add_solid(tm, material=material, degree=1)
+    sc.fix(soil, "base")
+    sc.fix(soil, "sides", dofs=("ux",))
+    sc.load(soil, "beam_left", traction=(0.0, -Q_TOP))
+    sc.monitor("surface", soil, "beam_left", reduce="min")
+    beams = []
+    if with_beam:
+        for group in ("beam_left", "beam_right"):
+            beams.append(sc.add_beam(lines, group, section=dc.Rectangle(0.3, 0.3), material=dc.Elastic(E_BEAM)))
+    return sc, soil, beams
+
+
+def _activate_on_settled_ground(large: bool, approach: str):
+    sc, soil, beams = _ground_and_beam(large)
+    results = solve_stages(sc, [Stage("surcharge", driver=dc.LoadControl(steps=2)),
+                                Stage("beam", add=[(b, b.name) for b in beams])], approach=approach)
+    return results, soil, beams
+
+
+@pytest.mark.parametrize("large", [False, True])
+def test_a_beam_added_on_settled_ground_is_stress_free_with_approach_two(large):
+    """Approach II (seed §3.1.2): a structure is added undeformed in the configuration of that
+    moment, its deformation U − U_os. A beam activated along a surface that a surcharge has
+    settled into a trough (of 2 % of the loaded width) carries no force (round-off: 1e-9 of the
+    surcharge's resultant), and the ground does not move — geometrically linear or co-rotational."""
+    results, soil, beams = _activate_on_settled_ground(large, "II")
+    settled, after = results[0].history.rows[-1]["surface_uy_min"], results[1].history.rows[-1]["surface_uy_min"]
+    assert settled < -0.02 * WP
+    assert after == pytest.approx(settled, rel=1e-12)
+    _, forces = beams[0].model.element_forces()
+    assert comm.allreduce(len(forces)) == int(round(2 * WG))  # every element exists
+    assert comm.allreduce(float(np.abs(forces).max(initial=0.0)), op=MPI.MAX) < 1e-9 * Q_TOP * WP
+
+
+def test_a_beam_added_on_settled_ground_carries_the_settlement_with_approach_one():
+    """Approach I: the mesh is the structure's reference and U its deformation, so a beam added
+    on the settled surface takes the curvature of the trough as its own: the stage ends where a
+    single analysis with the beam present from the start ends (geometrically linear, history
+    does not matter), node by node to 1e-9. The beam bent into the trough pushes back: the trough
+    rises (by 0.16 % here) and its elements carry end forces of 13 % of the surcharge's resultant."""
+    results, soil, beams = _activate_on_settled_ground(False, "I")
+    settled, after = results[0].history.rows[-1]["surface_uy_min"], results[1].history.rows[-1]["surface_uy_min"]
+    direct, direct_soil, _ = _ground_and_beam(False)
+    dc.solve(direct, dc.LoadControl(steps=1))
+    staged, reference = _nodal(soil), _nodal(direct_soil)
+    scale = max(abs(v).max() for v in reference.values())
+    assert all(np.abs(staged[p] - u).max() < 1e-9 * scale for p, u in reference.items())
+    assert after > settled + 1e-3 * abs(settled)  # (settlements are negative: the beam lifts the trough)
+    _, forces = beams[0].model.element_forces()
+    assert comm.allreduce(float(np.abs(forces).max(initial=0.0)), op=MPI.MAX) > 0.1 * Q_TOP * WP
+
+
+@pytest.mark.skipif(comm.size > 1, reason="dense finite differences of the assembled system: serial")
+@pytest.mark.parametrize("large", [False, True])
+def test_staged_beam_tangent_matches_finite_differences(large):
+    """The tangent of 2D beams added undeformed in a deformed configuration (approach II: reference
+    X + a, deformation d − a, with a the memorized state of the nodes, here random and large: 0.3
+    in translation, 0.5 rad) against central differences of the residual, free dofs (1e-6)."""
+    from dolfinx_corot.io.gmsh_models import polyline
+    sc = dc.Scene(large_rotations=large, linear_solver="direct")
+    beam = sc.add_beam(polyline([[0.0, 0.0], [2.0, 0.5]], 4), "beam", section=dc.Rectangle(0.2, 0.3),
+                       material=dc.Elastic(1.0e4))
+    sc.fix(beam, "base")
+    sc.load(beam, "tip", force=(0.0, -1.0))
+    solve_stages(sc, [Stage("place", add=[(beam, "beam")])], approach="II")
+    model = beam.model
+    rng = np.random.default_rng(3)
+    act = model.activation.x.array.reshape(-1, 2, 3)
+    act[:] = rng.uniform(-0.3, 0.3, act.shape) * np.array([1.0, 1.0, 5.0 / 3.0])
+    system = make_system(sc.model, solver="direct")
+    try:
+        model.state.x.array[:] += rng.uniform(-0.1, 0.1, model.state.x.array.shape)
+        K, Kfd = tangent_and_fd(system, model.state.x.array, 1.0)
+        fixed = np.concatenate([bc.dof_indices()[0] for bc in system.bcs])
+    finally:
+        system.destroy()
+    free = np.setdiff1d(np.arange(len(K)), fixed)
     K, Kfd = K[np.ix_(free, free)], Kfd[np.ix_(free, free)]
     assert np.abs(K).max() > 100.0
     assert np.abs(K - Kfd).max() < 1e-6 * np.abs(K).max()

@@ -14,7 +14,8 @@ class DofLayout:
     A node is identified by (node source, input node number): the meshes read
     from one gmsh model (or built from one array of points with the same
     ``node_source``) share the nodes they have in common, which become one
-    node of the system with one set of dofs. A shared node is owned by the
+    node of the system with one set of dofs (those of the model with most: a solid's
+    node shared with a beam or shell has its translations and their rotations). A shared node is owned by the
     rank that owns it in the first model holding it; nodes are numbered rank
     by rank, so each rank owns a contiguous range of scalar dofs.
 
@@ -45,12 +46,15 @@ class DofLayout:
         first[1:] = ks[1:] != ks[:-1]
         primary = order[first]
         ukeys, owner, pmodel = allk[primary], allr[primary], allm[primary]
-        ncomp = np.array([m.ndof for m in models], dtype=np.int64)[pmodel]
-        # every model holding a shared node must give it the same dofs
+        # a shared node has the dofs of the model with most of them (a solid's translations are the
+        # first dofs of a beam's or shell's node); the others' dofs must be their leading ones
+        ndofs = np.array([m.ndof for m in models], dtype=np.int64)
+        ncomp = np.maximum.reduceat(ndofs[allm[order]], np.flatnonzero(first))
         for i, m in enumerate(models):
             idx = np.searchsorted(ukeys, keys[i])
             for j in np.unique(pmodel[idx]):
-                if models[j].dof_names != m.dof_names:
+                a, b = sorted((m.dof_names, models[j].dof_names), key=len)
+                if b[: len(a)] != a:
                     raise ValueError(f"parts of kinds {[p.kind for p in m.parts]} and "
                                      f"{[p.kind for p in models[j].parts]} share nodes but have different dofs "
                                      f"({m.dof_names} and {models[j].dof_names})")

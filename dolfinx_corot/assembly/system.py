@@ -496,10 +496,15 @@ class System:
         self.fext.copy(out)
         dolfinx.fem.petsc.set_bc(out, self.bcs, None, 0.0)
 
+    def parts_internal_force(self) -> np.ndarray:
+        """f_int of the parts alone (no contributions) at the current configuration, owned entries."""
+        self._assemble_parts()
+        return self.fint.array.copy()
+
     def ramp_loads_from(self, previous: np.ndarray | None) -> np.ndarray:
         """Stage loads: f_ext(λ) = F_prev + λ (F − F_prev), with F the external force assembled
-        for this system and F_prev (owned entries) that of the stage before (None: F_prev = 0).
-        Returns F (owned entries), the next stage's F_prev."""
+        for this system and F_prev (owned entries) where the stage starts (None: F_prev = 0).
+        Returns F (owned entries)."""
         target = self.fext.array.copy()
         if previous is not None:
             self.fext.array[:] -= previous
@@ -669,6 +674,7 @@ class CoupledSystem(System):
             blocks.append(loc[(cells[:, :, None] * m.ndof + np.arange(m.ndof)).reshape(len(cells), -1)])
         self.A = petsc.layout_matrix(comm, lay.imap, blocks, lay.n_owned)
         self.b = petsc.layout_vector(lay.imap)
+        self._diagonal_kept = False
         self._model_forms = [m.forms() for m in models]
         self._lgmaps = [petsc.lgmap(comm, gd) for gd in lay.gdofs]
         self._mvec = [petsc.form_vector(L) for L, _ in self._model_forms]
@@ -740,6 +746,15 @@ class CoupledSystem(System):
             bend.append((r * m.bending_blocks()[:, None]).ravel())
         free = (self._owned_indicator(rot) > 0) & (self._owned_indicator(bend) == 0)
         groups.append((np.flatnonzero(free).astype(np.int32), 0.0, None))
+        # staged construction: dofs that no existing element of any model touches are held
+        active = []
+        for m in models:
+            a = np.ones((len(m.bending_blocks()), m.ndof))
+            a[m.held_blocks()] = 0.0
+            active.append(a.ravel())
+        held = np.flatnonzero(self._owned_indicator(active) == 0).astype(np.int32)
+        if len(held):
+            groups.append((held, None, None))  # held where they are
         fixed = np.unique(np.concatenate([g[0] for g in groups])).astype(np.int32)
         return groups, fixed
 
@@ -767,11 +782,15 @@ class CoupledSystem(System):
         self._add_from_models(self.fint, arrays)
 
     def _displacements(self) -> np.ndarray:
-        """Owned entries of the displacement vector (rotational entries 0)."""
+        """Owned entries of the displacement vector (rotational entries 0). An owned dof may be held
+        by models on other ranks only (a solid's node owned here, the beam sharing it elsewhere):
+        the holders' values reach the owner (they agree, so inserting is summing once)."""
         with self._xglobal.localForm() as f:
+            f.set(0.0)
             for m, loc in zip(self.model.models, self.layout.local):
                 with m.displacement_vector().localForm() as x:
                     f.array[loc] = x.array
+        self._xglobal.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.REVERSE)
         return self._xglobal.array
 
     def _constrain_residual(self, load_factor: float) -> None:
@@ -780,6 +799,9 @@ class CoupledSystem(System):
             f.set(0.0)
         lift = self.lift.array
         for rows, value, amp in self._constraints:
+            if value is None:  # held where they are (staged construction)
+                lift[rows] = 0.0
+                continue
             target = value * (load_factor if amp is None else amp(load_factor))
             lift[rows] = target - x[rows]
         self.b.array[self._fixed] = lift[self._fixed]
@@ -793,6 +815,15 @@ class CoupledSystem(System):
             A.setLGMap(lg, lg)
             _dolfinx.assemble_matrix_into(A, a)
         A.setLGMap(*lg0)
+        if not self._diagonal_kept:
+            # explicit zeros on the diagonal before the first assembly fixes the pattern: rows that no
+            # element reaches (nodes of cells without elements, or of elements that do not exist
+            # yet) keep their diagonal, to be constrained
+            n = self.layout.n_owned
+            A.setValuesCSR(np.arange(n + 1, dtype=PETSc.IntType),
+                           np.arange(self.layout.start, self.layout.start + n, dtype=PETSc.IntType),
+                           np.zeros(n), addv=PETSc.InsertMode.ADD_VALUES)
+            self._diagonal_kept = True
         A.assemble()
 
     def _constrain_matrix(self) -> None:

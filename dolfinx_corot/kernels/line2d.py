@@ -14,6 +14,9 @@ For DOLFINx the two are wrapped in numba ``cfunc`` tabulate-tensor kernels
   where θ is the total nodal angle (node-major, as DOLFINx packs a
   blocked space);
 * ``c`` = [large_rotations (1.0 or 0.0)];
+* staged elements (:func:`staged_kernels`) read after the props the state of their nodes when
+  they appeared, a (6,): element added undeformed in the configuration of that moment
+  (seed §3.1.2, approach II) — reference X + a, deformation d − a;
 * ``coords`` = (2, 3) initial nodal coordinates (padded to 3).
 """
 from __future__ import annotations
@@ -94,3 +97,26 @@ def _tabulate(w, c, X, f, K, tangent):
 
 
 vector_kernel, matrix_kernel = tabulate_tensor_kernels(_tabulate, NDOF, NCOEF, 2)
+
+
+@numba.njit(cache=True, inline="always")
+def _tabulate_staged(w, c, X, f, K, tangent):
+    """An element that appeared undeformed when its nodes' state was a = w[NCOEF:]: its reference
+    is the nodes' position then (X + a), its deformation d − a (angles in the plane add)."""
+    a = w[NCOEF:NCOEF + NDOF]
+    d = np.empty(NDOF)
+    for j in range(NDOF):
+        d[j] = w[j] - a[j]
+    evaluate(X[0, 0] + a[0], X[0, 1] + a[1], X[1, 0] + a[3], X[1, 1] + a[4], d, w[NDOF:NCOEF],
+             c[0] != 0.0, f, K)
+
+
+_staged = None
+
+
+def staged_kernels():
+    """(vector_kernel, matrix_kernel) of staged elements (compiled on first use)."""
+    global _staged
+    if _staged is None:
+        _staged = tabulate_tensor_kernels(_tabulate_staged, NDOF, NCOEF + NDOF, 2)
+    return _staged

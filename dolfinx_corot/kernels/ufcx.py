@@ -59,7 +59,7 @@ def tabulate_tensor_kernels(tabulate, ndof: int, ncoef: int, nnode: int, nconst:
     module that defines ``tabulate`` (their code object is re-labelled with that
     module's file, their qualified name carries a hash of this file): the
     on-disk cache is then invalidated when either file changes, and two element
-    modules never share an entry. A closure over ``tabulate`` would not do:
+    functions (of one module or two) never share an entry (the name of ``tabulate`` is in it). A closure over ``tabulate`` would not do:
     numba keys the cache of a closure on the pickle of its cells, and a jitted
     function pickles with a fresh id in every process, so such a cache never
     hits (and grows at every import).
@@ -74,7 +74,7 @@ def tabulate_tensor_kernels(tabulate, ndof: int, ncoef: int, nnode: int, nconst:
                        (_matrix_kernel, f"element matrix ({ndof}, {ndof})")):
         name = body.__name__[1:]
         code = body.__code__.replace(co_filename=module_file, co_name=name,
-                                     co_qualname=f"{name}_{_VERSION}")
+                                     co_qualname=f"{name}{tabulate.__name__}_{_VERSION}")
         fn = FunctionType(code, env, name)
         fn.__doc__ = f"ufcx tabulate_tensor of the {what} of {module}."
         made.append(numba.cfunc(signature, nopython=True, cache=True)(fn))

@@ -185,8 +185,8 @@ class Part:
     def start_staging(self, approach: str) -> None:
         """Take part in staged construction (:mod:`dolfinx_corot.staging`): existence per element
         from now on. Parts that cannot be staged yet say so."""
-        raise NotImplementedError(f"staged construction: {self.kind_name} parts are not staged yet, only solids "
-                                  "(structures, contact and excavation in stages: issue 14, next part)")
+        raise NotImplementedError(f"staged construction: {type(self).__name__} parts are not staged yet, only "
+                                  "solids and 2D beams and bars")
 
     def held_blocks(self) -> np.ndarray:
         """Local blocks (owned and ghost) of nodes that no existing element touches (staged
@@ -209,9 +209,12 @@ class Part:
         for comp in range(self.translations, self.ndof):
             bcs.append(dolfinx.fem.dirichletbc(zero, free * self.ndof + comp, self.V.sub(comp)))
         held = self.held_blocks()
-        if len(held):  # nodes of no existing element (staged construction): held where they are
-            for comp in range(self.ndof):
-                bcs.append(dolfinx.fem.dirichletbc(zero, held * self.ndof + comp, self.V.sub(comp)))
+        if self.comm.allreduce(len(held)):  # nodes of no existing element (staged construction): held where
+            # they are (the Function is made on every rank: its vector is collective)
+            here = dolfinx.fem.Function(self.V)
+            with self.displacement_vector().localForm() as x:
+                here.x.array[:] = x.array
+            bcs.append(dolfinx.fem.dirichletbc(here, np.sort(held).astype(np.int32)))
         self._prescribed_values = []
         self.lifting_bcs = []
         for entities, comp, motion in self._prescribed:

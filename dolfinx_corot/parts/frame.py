@@ -146,7 +146,10 @@ class LineFrame(Part):
     def _weight_cells(self, label: str, where: str | None) -> np.ndarray:
         """Owned cells of the elements ``label``, within group ``where`` if given."""
         n_owned = self.tmesh.mesh.topology.index_map(self.tdim).size_local
-        cells = np.flatnonzero(self._owner_of_cell[:n_owned] == label).astype(np.int32)
+        mine = self._owner_of_cell[:n_owned] == label
+        if self._existing is not None:
+            mine &= self._existing[:n_owned]
+        cells = np.flatnonzero(mine).astype(np.int32)
         if where is not None:
             cells = np.intersect1d(cells, self.tmesh.cells(where))
         return cells
@@ -185,7 +188,7 @@ class LineFrame(Part):
         for label, where, q in terms:
             cells = self._weight_cells(label, where)
             blocks = cell_blocks[cells]
-            X = self.reference[blocks]
+            X = self.reference[blocks] + self._activation_translations(cells)
             if self.tdim == 1:
                 forces, moments = uniform_load.line_loads(X, q, self._bending[cells])
                 np.add.at(arr[:, g:], blocks, moments.reshape(len(cells), 2, self.ndof - g))
@@ -203,13 +206,15 @@ class LineFrame(Part):
     def forms(self):
         if self._forms is None:
             cmap = self.tmesh.mesh.topology.index_map(self.tdim)
-            owned = np.flatnonzero(self._owner_of_cell[: cmap.size_local] != "").astype(np.int32)
+            active = self._cells_active()[: cmap.size_local]
+            owned = np.flatnonzero(active).astype(np.int32)
             all_owned = self.comm.allreduce(bool(len(owned) == cmap.size_local), op=MPI.LAND)
             cells = None if all_owned else owned
             self._flag = dolfinx.fem.Constant(self.V.mesh, PETSc.ScalarType(1.0 if self.large_rotations else 0.0))
             coeffs = [self.state, self.props, *self._element_constants()]
-            L = _dolfinx.kernel_form(self.V, self.kernels.vector_kernel.address, 1, coeffs, [self._flag], cells)
-            a = _dolfinx.kernel_form(self.V, self.kernels.matrix_kernel.address, 2, coeffs, [self._flag], cells)
+            vector_kernel, matrix_kernel = self._kernel_pair()
+            L = _dolfinx.kernel_form(self.V, vector_kernel.address, 1, coeffs, [self._flag], cells)
+            a = _dolfinx.kernel_form(self.V, matrix_kernel.address, 2, coeffs, [self._flag], cells)
             self._forms = (L, a)
         return self._forms
 
@@ -217,12 +222,28 @@ class LineFrame(Part):
         """Extra per-cell coefficients the kernels read after the properties (none by default)."""
         return []
 
+    def _kernel_pair(self):
+        """(vector kernel, matrix kernel) of the elements."""
+        return self.kernels.vector_kernel, self.kernels.matrix_kernel
+
+    _existing: np.ndarray | None = None  # staged construction: which local cells exist (None: all)
+
+    def _cells_active(self) -> np.ndarray:
+        """Local cells (owned and ghost) with elements that exist."""
+        active = self._owner_of_cell != ""
+        return active if self._existing is None else active & self._existing
+
+    def _activation_translations(self, cells: np.ndarray) -> np.ndarray | float:
+        """(cells, nodes, gdim) translation of the elements' reference from the mesh (elements
+        added undeformed in a deformed configuration); 0 by default."""
+        return 0.0
+
     def bending_blocks(self) -> np.ndarray:
         """Local blocks (owned and ghost) that a bending element on this rank touches."""
         nblocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
         flags = np.zeros(nblocks, dtype=bool)
         dofs = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)
-        flags[dofs[self._bending[: len(dofs)]].ravel()] = True
+        flags[dofs[(self._bending & self._cells_active())[: len(dofs)]].ravel()] = True
         return flags
 
     def _fixed_blocks(self) -> np.ndarray:
@@ -278,6 +299,84 @@ class Frame2D(AdditiveState, LineFrame):
     def _add(self, where, EA, EI, GAs, N0, kind):
         law2d.check_props(EA, EI, GAs, f"{kind} '{where}'")
         return self.add_elements(where, np.array([EA, EI, GAs, N0]), EI > 0.0, kind)
+
+    # -- staged construction (dolfinx_corot.staging) ---------------------------------
+    activation: dolfinx.fem.Function | None = None
+
+    def start_staging(self, approach: str) -> None:
+        """Existence per element from now on (none until :meth:`set_existing`). Approach II
+        (seed §3.1.2): an element appears undeformed in the configuration of that moment — the
+        state of its nodes then, U_os, is memorized per element and its deformation is U − U_os,
+        its reference the positions X + U_os. Approach I: the mesh is the reference and U the
+        deformation (fit for small construction deformations, or nodes at rest until then)."""
+        if self._existing is None:
+            self._existing = np.zeros(len(self._owner_of_cell), dtype=bool)
+            Q = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("DG", 0), dim=2 * self.ndof)
+            self.activation = dolfinx.fem.Function(Q, name="activation")
+        self.approach = approach
+        self._forms = None
+
+    def cells_existing(self) -> np.ndarray:
+        """(local cells, owned and ghost) whether each exists."""
+        return self._existing.copy()
+
+    def set_existing(self, exists: np.ndarray) -> None:
+        """Which local cells exist; with approach II the new ones memorize their nodes' state."""
+        new = exists & ~self._existing
+        if self.approach == "II" and new.any():
+            blocks = self.V.dofmap.list.array.reshape(-1, 2)[new]
+            act = self.activation.x.array.reshape(-1, 2 * self.ndof)
+            act[self.activation.function_space.dofmap.list.array[new]] = \
+                self.state.x.array.reshape(-1, self.ndof)[blocks].reshape(-1, 2 * self.ndof)
+        self._existing = np.asarray(exists, dtype=bool).copy()
+        self._forms = None
+
+    def held_blocks(self) -> np.ndarray:
+        if self._existing is None:
+            return np.zeros(0, dtype=np.int32)
+        cells = self.V.dofmap.list.array.reshape(-1, 2)
+        n_blocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
+        touched = np.zeros(n_blocks, dtype=bool)
+        touched[cells[self._cells_active()].ravel()] = True
+        flag = dolfinx.la.vector(self.V.dofmap.index_map)  # touched on another rank only: ask the owners
+        flag.array[:] = touched
+        flag.scatter_reverse(dolfinx.la.ScatterMode.add)
+        flag.scatter_forward()
+        return np.flatnonzero(flag.array[:n_blocks] == 0).astype(np.int32)
+
+    def _staged_shift(self) -> bool:
+        return self.activation is not None and self.approach == "II"
+
+    def _element_constants(self) -> list:
+        return [self.activation] if self._staged_shift() else []
+
+    def _kernel_pair(self):
+        return self.kernels.staged_kernels() if self._staged_shift() else super()._kernel_pair()
+
+    def _activation_translations(self, cells: np.ndarray) -> np.ndarray | float:
+        if not self._staged_shift():
+            return 0.0
+        act = self.activation.x.array.reshape(-1, 2, self.ndof)
+        return act[self.activation.function_space.dofmap.list.array[cells], :, : self.gdim]
+
+    def element_forces(self) -> tuple[np.ndarray, np.ndarray]:
+        """(cells, forces): the owned cells with existing elements and their end forces and
+        moments (n, 6) in global axes, (Fx, Fy, M) at node 1 then node 2 — the forces the element
+        exerts on its nodes' equilibrium, f_int."""
+        n_owned = self.tmesh.mesh.topology.index_map(1).size_local
+        cells = np.flatnonzero(self._cells_active()[:n_owned]).astype(np.int32)
+        blocks = self.V.dofmap.list.array.reshape(-1, 2)[cells]
+        X = self.reference[blocks]
+        D = self.state.x.array.reshape(-1, self.ndof)[blocks].reshape(-1, 2 * self.ndof)
+        if self._staged_shift():
+            a = self.activation.x.array.reshape(-1, 2 * self.ndof)[self.activation.function_space.dofmap.list.array[cells]]
+            X = X + a.reshape(-1, 2, self.ndof)[:, :, :2]
+            D = D - a
+        F = np.zeros((len(cells), 6))
+        K = np.zeros((len(cells), 6, 6))
+        self.kernels.evaluate_all(np.ascontiguousarray(X), np.ascontiguousarray(D), self.cell_properties(cells),
+                                  self.large_rotations, F, K)
+        return cells, F
 
     def surface(self, where: str) -> Surface:
         """The beams of line group ``where`` as a two-sided contact surface: the axis offset by half

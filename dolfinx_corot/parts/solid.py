@@ -259,7 +259,8 @@ class Solid(AdditiveState, Part):
             mesh = self.V.mesh
             self.existing = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, ("DG", 0)), name="existing")
             cell = self.V.ufl_element().cell()
-            element = ufl.VectorElement("DG", cell, self.degree)
+            family = "DQ" if cell.cellname() in ("quadrilateral", "hexahedron") else "DG"
+            element = ufl.VectorElement(family, cell, self.degree)
             self.activation_shift = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, element),
                                                          name="activation_shift")
             self._forms = None
@@ -280,6 +281,48 @@ class Solid(AdditiveState, Part):
             cg = self.V.dofmap.list.array.reshape(-1, n)[new].ravel()
             self.activation_shift.x.array.reshape(-1, self.gdim)[dg] = self.state.x.array.reshape(-1, self.gdim)[cg]
         self.existing.x.array[self._cell_dof] = exists.astype(float)
+
+    def reset_displacements(self) -> None:
+        """Discard the displacement, keep the strains (a geostatic stage): each existing cell's
+        shift becomes s − u, so that its strain measure (of u − s, or F = (I + ∇u)(I + ∇s)⁻¹) is
+        unchanged while u = 0. At small strain the stresses are kept exactly; at large strain the
+        existing cells are referred to X − u (the mesh is the deformed state)."""
+        exists = self.cells_existing()
+        n = self.nodes_per_cell
+        dg = self.activation_shift.function_space.dofmap.list.array.reshape(-1, n)[exists].ravel()
+        cg = self.V.dofmap.list.array.reshape(-1, n)[exists].ravel()
+        self.activation_shift.x.array.reshape(-1, self.gdim)[dg] -= self.state.x.array.reshape(-1, self.gdim)[cg]
+        self.state.x.array[:] = 0.0
+
+    def cell_stress(self) -> np.ndarray:
+        """Cauchy stress at the centre of every owned cell, (cells, gdim, gdim): σ = P Fᵀ / det F
+        at large rotations, the small-strain stress otherwise (non-existing cells: 0)."""
+        u = self.state
+        if self.existing is not None:
+            s = self.activation_shift
+            I = ufl.Identity(self.gdim)
+            lmbda, mu = lame(self.E, self.nu)
+            if not self.large_rotations:
+                eps = ufl.sym(ufl.grad(u - s))
+                sigma = lmbda * ufl.tr(eps) * I + 2.0 * mu * eps
+            else:
+                if self.approach == "I":
+                    F = I + ufl.grad(u - s)
+                else:
+                    F = ufl.dot(I + ufl.grad(u), ufl.inv(I + ufl.grad(s)))
+                sigma = ufl.dot(first_piola(self.law, F, lmbda, mu), F.T) / ufl.det(F)
+            sigma = self.existing * sigma
+        elif self.large_rotations:
+            F = ufl.Identity(self.gdim) + self._gradient(u)
+            sigma = ufl.dot(self.stress(u), F.T) / ufl.det(F)
+        else:
+            sigma = self.stress(u)
+        cell = self.V.mesh.ufl_cell().cellname()
+        centre = {"triangle": [[1 / 3, 1 / 3]], "quadrilateral": [[0.5, 0.5]],
+                  "tetrahedron": [[0.25, 0.25, 0.25]], "hexahedron": [[0.5, 0.5, 0.5]]}[cell]
+        expr = dolfinx.fem.Expression(sigma, np.array(centre, dtype=float))
+        owned = np.arange(self.V.mesh.topology.index_map(self.tdim).size_local, dtype=np.int32)
+        return expr.eval(owned).reshape(len(owned), self.gdim, self.gdim)
 
     def held_blocks(self) -> np.ndarray:
         if self.existing is None:

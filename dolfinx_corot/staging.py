@@ -132,9 +132,10 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
 
 
 def _check_resettable(system, staged: dict, stage: Stage) -> None:
-    """Only staged solids can discard their displacements and keep their strains."""
+    """Only staged parts that keep their strains without their displacements (solids) can be reset."""
     for model in system.models:
-        if id(model) not in staged:
-            raise NotImplementedError(f"solve_stages: stage '{stage.name}' discards the displacements, "
-                                      f"but a {type(model).__name__} is not staged (only staged solids can "
-                                      "keep their strains without their displacements)")
+        if id(model) not in staged or not model.keeps_strains_without_displacements:
+            kinds = ", ".join(sorted({f"{p.kind} '{p.name}'" for p in model.parts}))
+            why = "is not staged" if id(model) not in staged else "cannot keep its strains without its displacements"
+            raise NotImplementedError(f"solve_stages: stage '{stage.name}' discards the displacements, but {kinds} "
+                                      f"{why} (only staged solids can: put the structures in later stages)")

@@ -415,3 +415,17 @@ def test_staged_beam_tangent_matches_finite_differences(large):
     K, Kfd = K[np.ix_(free, free)], Kfd[np.ix_(free, free)]
     assert np.abs(K).max() > 100.0
     assert np.abs(K - Kfd).max() < 1e-6 * np.abs(K).max()
+
+
+def test_a_geostatic_stage_with_parts_that_cannot_discard_their_displacements_is_named():
+    """A stage that discards the displacements needs every part staged and able to keep its
+    strains without them (solids): an unstaged solid, or beams in that stage, are refused before
+    anything is solved, naming the part."""
+    sc, soil, beams = _ground_and_beam(False)
+    adds = [(b, b.name) for b in beams]
+    with pytest.raises(NotImplementedError, match=r"stage 'g' discards the displacements, but solid '.*' is not staged"):
+        solve_stages(sc, [Stage("g", add=adds, reset_displacements=True)])
+    sc, soil, beams = _ground_and_beam(False)
+    adds = [(soil, "ground")] + [(b, b.name) for b in beams]
+    with pytest.raises(NotImplementedError, match="but beam 'beam_left', beam 'beam_right' cannot keep its strains"):
+        solve_stages(sc, [Stage("g", add=adds, reset_displacements=True)])

@@ -21,6 +21,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 import dolfinx.fem
+import dolfinx.la
 
 from ..io.mesh import TaggedMesh
 from .groups import NodeGroup, gather_group
@@ -192,6 +193,27 @@ class Part:
         """Local blocks (owned and ghost) of nodes that no existing element touches (staged
         construction); none by default."""
         return np.zeros(0, dtype=np.int32)
+
+    def _untouched_blocks(self, cells: np.ndarray) -> np.ndarray:
+        """Local blocks (owned and ghost) that none of the local ``cells`` on any rank touches."""
+        dofs = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)
+        n_blocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
+        touched = np.zeros(n_blocks, dtype=bool)
+        touched[dofs[cells].ravel()] = True
+        # a node touched by a cell on another rank only: ask the owners (reverse, sum)
+        flag = dolfinx.la.vector(self.V.dofmap.index_map)
+        flag.array[:] = touched
+        flag.scatter_reverse(dolfinx.la.ScatterMode.add)
+        flag.scatter_forward()
+        return np.flatnonzero(flag.array[:n_blocks] == 0).astype(np.int32)
+
+    #: a geostatic stage may discard this part's displacements and keep its strains
+    #: (:meth:`reset_displacements`; staged solids)
+    keeps_strains_without_displacements = False
+
+    def reset_displacements(self) -> None:
+        raise NotImplementedError(f"{type(self).__name__} parts cannot discard their displacements and keep "
+                                  "their strains")
 
     def _fixed_blocks(self) -> np.ndarray:
         """Blocks whose non-translational dofs have no stiffness (fixed); none by default."""

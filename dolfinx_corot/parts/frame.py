@@ -325,24 +325,15 @@ class Frame2D(AdditiveState, LineFrame):
         new = exists & ~self._existing
         if self.approach == "II" and new.any():
             blocks = self.V.dofmap.list.array.reshape(-1, 2)[new]
-            act = self.activation.x.array.reshape(-1, 2 * self.ndof)
-            act[self.activation.function_space.dofmap.list.array[new]] = \
-                self.state.x.array.reshape(-1, self.ndof)[blocks].reshape(-1, 2 * self.ndof)
+            act = self.activation.x.array.reshape(-1, 2, self.ndof)
+            act[self.activation.function_space.dofmap.list.array[new]] = self.state.x.array.reshape(-1, self.ndof)[blocks]
         self._existing = np.asarray(exists, dtype=bool).copy()
         self._forms = None
 
     def held_blocks(self) -> np.ndarray:
         if self._existing is None:
             return np.zeros(0, dtype=np.int32)
-        cells = self.V.dofmap.list.array.reshape(-1, 2)
-        n_blocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
-        touched = np.zeros(n_blocks, dtype=bool)
-        touched[cells[self._cells_active()].ravel()] = True
-        flag = dolfinx.la.vector(self.V.dofmap.index_map)  # touched on another rank only: ask the owners
-        flag.array[:] = touched
-        flag.scatter_reverse(dolfinx.la.ScatterMode.add)
-        flag.scatter_forward()
-        return np.flatnonzero(flag.array[:n_blocks] == 0).astype(np.int32)
+        return self._untouched_blocks(self._cells_active())
 
     def _staged_shift(self) -> bool:
         return self.activation is not None and self.approach == "II"
@@ -353,11 +344,12 @@ class Frame2D(AdditiveState, LineFrame):
     def _kernel_pair(self):
         return self.kernels.staged_kernels() if self._staged_shift() else super()._kernel_pair()
 
+    def _activations(self, cells: np.ndarray) -> np.ndarray:
+        """(cells, 2, ndof) state of the cells' nodes when they appeared (approach II)."""
+        return self.activation.x.array.reshape(-1, 2, self.ndof)[self.activation.function_space.dofmap.list.array[cells]]
+
     def _activation_translations(self, cells: np.ndarray) -> np.ndarray | float:
-        if not self._staged_shift():
-            return 0.0
-        act = self.activation.x.array.reshape(-1, 2, self.ndof)
-        return act[self.activation.function_space.dofmap.list.array[cells], :, : self.gdim]
+        return self._activations(cells)[:, :, : self.gdim] if self._staged_shift() else 0.0
 
     def element_forces(self) -> tuple[np.ndarray, np.ndarray]:
         """(cells, forces): the owned cells with existing elements and their end forces and
@@ -366,12 +358,10 @@ class Frame2D(AdditiveState, LineFrame):
         n_owned = self.tmesh.mesh.topology.index_map(1).size_local
         cells = np.flatnonzero(self._cells_active()[:n_owned]).astype(np.int32)
         blocks = self.V.dofmap.list.array.reshape(-1, 2)[cells]
-        X = self.reference[blocks]
+        X = self.reference[blocks] + self._activation_translations(cells)
         D = self.state.x.array.reshape(-1, self.ndof)[blocks].reshape(-1, 2 * self.ndof)
         if self._staged_shift():
-            a = self.activation.x.array.reshape(-1, 2 * self.ndof)[self.activation.function_space.dofmap.list.array[cells]]
-            X = X + a.reshape(-1, 2, self.ndof)[:, :, :2]
-            D = D - a
+            D = D - self._activations(cells).reshape(-1, 2 * self.ndof)
         F = np.zeros((len(cells), 6))
         K = np.zeros((len(cells), 6, 6))
         self.kernels.evaluate_all(np.ascontiguousarray(X), np.ascontiguousarray(D), self.cell_properties(cells),

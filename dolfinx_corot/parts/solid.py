@@ -233,23 +233,32 @@ class Solid(AdditiveState, Part):
         return first_piola(self.law, F, lmbda, mu)
 
     # -- staged construction ----------------------------------------------------------
-    def _staged_integrand(self, u, v):
-        """P(F) : ∇v per cell with the cell's activation shift s (module dolfinx_corot.staging):
-        small strain, and approach I: strains of u − s on the mesh; approach II at large
-        rotations: the reference is X + s, F = (I + ∇u)(I + ∇s)⁻¹, integrated over the
-        reference (det(I + ∇s) dX, ∇_{X+s} v = ∇v (I + ∇s)⁻¹)."""
+    def _staged_kinematics(self, u):
+        """Per cell, with its activation shift s (module dolfinx_corot.staging): the small strain
+        ε(u − s), or F with the Jacobian J₀ of the cell's reference over the mesh (None: the mesh):
+        approach I F = I + ∇(u − s) on the mesh; approach II the reference is X + s,
+        F = (I + ∇u)(I + ∇s)⁻¹, J₀ = I + ∇s."""
         s = self.activation_shift
-        lmbda, mu = lame(self.E, self.nu)
         I = ufl.Identity(self.gdim)
         if not self.large_rotations:
-            eps = ufl.sym(ufl.grad(u - s))
-            return ufl.inner(lmbda * ufl.tr(eps) * I + 2.0 * mu * eps, ufl.grad(v))
+            return ufl.sym(ufl.grad(u - s)), None
         if self.approach == "I":
-            return ufl.inner(first_piola(self.law, I + ufl.grad(u - s), lmbda, mu), ufl.grad(v))
+            return I + ufl.grad(u - s), None
         J0 = I + ufl.grad(s)
-        J0inv = ufl.inv(J0)
-        F = ufl.dot(I + ufl.grad(u), J0inv)
-        return ufl.det(J0) * ufl.inner(first_piola(self.law, F, lmbda, mu), ufl.dot(ufl.grad(v), J0inv))
+        return ufl.dot(I + ufl.grad(u), ufl.inv(J0)), J0
+
+    def _staged_integrand(self, u, v):
+        """P(F) : ∇v per cell (:meth:`_staged_kinematics`); approach II at large rotations is
+        integrated over the reference X + s (det J₀ dX, ∇_{X+s} v = ∇v J₀⁻¹)."""
+        lmbda, mu = lame(self.E, self.nu)
+        measure, J0 = self._staged_kinematics(u)
+        if not self.large_rotations:
+            eps = measure
+            return ufl.inner(lmbda * ufl.tr(eps) * ufl.Identity(self.gdim) + 2.0 * mu * eps, ufl.grad(v))
+        P = first_piola(self.law, measure, lmbda, mu)
+        if J0 is None:
+            return ufl.inner(P, ufl.grad(v))
+        return ufl.det(J0) * ufl.inner(P, ufl.dot(ufl.grad(v), ufl.inv(J0)))
 
     def start_staging(self, approach: str) -> None:
         """Existence per cell from now on (no cell exists until :meth:`set_existing`)."""
@@ -282,6 +291,8 @@ class Solid(AdditiveState, Part):
             self.activation_shift.x.array.reshape(-1, self.gdim)[dg] = self.state.x.array.reshape(-1, self.gdim)[cg]
         self.existing.x.array[self._cell_dof] = exists.astype(float)
 
+    keeps_strains_without_displacements = True
+
     def reset_displacements(self) -> None:
         """Discard the displacement, keep the strains (a geostatic stage): each existing cell's
         shift becomes s − u, so that its strain measure (of u − s, or F = (I + ∇u)(I + ∇s)⁻¹) is
@@ -299,18 +310,12 @@ class Solid(AdditiveState, Part):
         at large rotations, the small-strain stress otherwise (non-existing cells: 0)."""
         u = self.state
         if self.existing is not None:
-            s = self.activation_shift
-            I = ufl.Identity(self.gdim)
             lmbda, mu = lame(self.E, self.nu)
+            measure, _ = self._staged_kinematics(u)
             if not self.large_rotations:
-                eps = ufl.sym(ufl.grad(u - s))
-                sigma = lmbda * ufl.tr(eps) * I + 2.0 * mu * eps
+                sigma = lmbda * ufl.tr(measure) * ufl.Identity(self.gdim) + 2.0 * mu * measure
             else:
-                if self.approach == "I":
-                    F = I + ufl.grad(u - s)
-                else:
-                    F = ufl.dot(I + ufl.grad(u), ufl.inv(I + ufl.grad(s)))
-                sigma = ufl.dot(first_piola(self.law, F, lmbda, mu), F.T) / ufl.det(F)
+                sigma = ufl.dot(first_piola(self.law, measure, lmbda, mu), measure.T) / ufl.det(measure)
             sigma = self.existing * sigma
         elif self.large_rotations:
             F = ufl.Identity(self.gdim) + self._gradient(u)
@@ -327,17 +332,7 @@ class Solid(AdditiveState, Part):
     def held_blocks(self) -> np.ndarray:
         if self.existing is None:
             return np.zeros(0, dtype=np.int32)
-        exists = self.cells_existing()
-        cells = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)
-        n_blocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
-        touched = np.zeros(n_blocks, dtype=bool)
-        touched[cells[exists].ravel()] = True
-        # a node touched by an existing cell on another rank only: ask the owners (reverse, max)
-        flag = dolfinx.la.vector(self.V.dofmap.index_map)
-        flag.array[:] = touched
-        flag.scatter_reverse(dolfinx.la.ScatterMode.add)
-        flag.scatter_forward()
-        return np.flatnonzero(flag.array[:n_blocks] == 0).astype(np.int32)
+        return self._untouched_blocks(self.cells_existing())
 
     def _check_complete(self) -> None:
         cmap = self.tmesh.mesh.topology.index_map(self.tdim)

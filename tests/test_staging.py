@@ -429,3 +429,180 @@ def test_a_geostatic_stage_with_parts_that_cannot_discard_their_displacements_is
     adds = [(soil, "ground")] + [(b, b.name) for b in beams]
     with pytest.raises(NotImplementedError, match="but beam 'beam_left', beam 'beam_right' cannot keep its strains"):
         solve_stages(sc, [Stage("g", add=adds, reset_displacements=True)])
+
+
+# -- mapping of new continuum (approach II) and contact in stages -----------------------------
+T_WALL, P_WALL, Q_PLATE, E_WALL = 0.2, 400.0, 200.0, 1.0e6
+
+
+def _pit_wall_plate():
+    """Ground [0, 6] × [0, 2] and a bank [0, 2] × [2, 4] on its left (density RHO), with a pit
+    [2.1, 6] × [2, 3] ('fill': weightless) right of the bank; a wall of beams (section T_WALL, group
+    'wall') along the bank's face x = 2 sharing its nodes, loaded at its top 'wall_top'; a plate of
+    beams ('plate') on the surface x ∈ [4, 6] sharing the ground's and the fill's nodes, loaded at
+    'plate_mid'. The fill's face 'fill_face' (x = 2.1: the wall's face in the mesh) has nodes of its
+    own. Quadrilaterals of 0.5 m (0.1 m across the strip x ∈ [2, 2.1])."""
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("pit_wall_plate")
+        geo = gmsh.model.geo
+        xs, ys = [0.0, 2.0, 2.1, 4.0, 5.0, 6.0], [0.0, 2.0, 3.0]
+        nx, ny = [4, 1, 4, 2, 2], [4, 2]
+        pts = {(i, j): geo.addPoint(xs[i], ys[j], 0.0) for i in range(6) for j in range(3)}
+        hor = {(i, j): geo.addLine(pts[i, j], pts[i + 1, j]) for i in range(5) for j in range(3)}
+        ver = {(i, j): geo.addLine(pts[i, j], pts[i, j + 1]) for i in range(6) for j in range(2)}
+        cells = {}
+        for i in range(5):
+            for j in range(2):
+                if j == 1 and i == 1:
+                    continue
+                loop = geo.addCurveLoop([hor[i, j], ver[i + 1, j], -hor[i, j + 1], -ver[i, j]])
+                cells[i, j] = geo.addPlaneSurface([loop])
+        # the bank's upper part [0, 2] × [3, 4]
+        b0, b1 = geo.addPoint(0.0, 4.0, 0.0), geo.addPoint(2.0, 4.0, 0.0)
+        bank_top, bank_left, bank_right = geo.addLine(b0, b1), geo.addLine(pts[0, 2], b0), geo.addLine(pts[1, 2], b1)
+        upper = geo.addPlaneSurface([geo.addCurveLoop([hor[0, 2], bank_right, -bank_top, -bank_left])])
+        for (i, j), c in hor.items():
+            geo.mesh.setTransfiniteCurve(c, nx[i] + 1)
+        for (i, j), c in ver.items():
+            geo.mesh.setTransfiniteCurve(c, ny[j] + 1)
+        for c in (bank_top, bank_left, bank_right):
+            geo.mesh.setTransfiniteCurve(c, {bank_top: nx[0], bank_left: 2, bank_right: 2}[c] + 1)
+        for sf in list(cells.values()) + [upper]:
+            geo.mesh.setTransfiniteSurface(sf)
+            geo.mesh.setRecombine(2, sf)
+        geo.synchronize()
+
+        def group(dim, tags, tag, name):
+            gmsh.model.addPhysicalGroup(dim, tags, tag)
+            gmsh.model.setPhysicalName(dim, tag, name)
+
+        group(2, [s for (i, j), s in cells.items() if j == 0 or i == 0] + [upper], 1, "ground")
+        group(2, [s for (i, j), s in cells.items() if j == 1 and i >= 2], 2, "fill")
+        group(1, [hor[i, 0] for i in range(5)], 3, "base")
+        group(1, [ver[0, 0], ver[0, 1], bank_left, ver[5, 0], ver[5, 1]], 4, "sides")
+        group(1, [ver[2, 1]], 5, "fill_face")
+        group(1, [ver[1, 1], bank_right], 6, "wall")
+        group(1, [hor[3, 1], hor[4, 1]], 7, "plate")
+        group(1, [hor[2, 1]], 8, "pit_floor")
+        group(0, [b1], 9, "wall_top")
+        group(0, [pts[4, 1]], 10, "plate_mid")
+        gmsh.model.mesh.generate(2)
+    tm = from_gmsh(gmsh.model, 2, comm=comm)
+    lines = from_gmsh(gmsh.model, 2, comm=comm, dim=1)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm, lines
+
+
+def _fill_against_a_wall(approach: str):
+    """Ground, pit excavated (stage 'excavate'), wall and plate built and loaded ('build': the wall
+    deflected away from the pit by P_WALL at its top, the plate pressed into the ground), then
+    the weightless fill placed against the wall ('fill', slaves on the wall): nothing changes in
+    the loads of the last stage, so it ends where it starts."""
+    tm, lines = _pit_wall_plate()
+    sc = dc.Scene(large_rotations=True, linear_solver="direct")
+    ground = sc.add_solid(tm, "ground", material=dc.SaintVenantKirchhoff(E, NU, density=RHO), degree=1)
+    fill = sc.add_solid(tm, "fill", material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+    wall = sc.add_beam(lines, "wall", section=dc.Rectangle(T_WALL, T_WALL), material=dc.Elastic(E_WALL))
+    plate = sc.add_beam(lines, "plate", section=dc.Rectangle(T_WALL, T_WALL), material=dc.Elastic(E_WALL))
+    sc.fix(ground, "base")
+    sc.fix(ground, "sides", dofs=("ux",))
+    sc.gravity(ground, (0.0, -G), where="ground")
+    sc.load(wall, "wall_top", force=(-P_WALL, 0.0))
+    sc.load(plate, "plate_mid", force=(0.0, -Q_PLATE))
+    pair = sc.contact((fill, "fill_face"), (wall, "wall"))
+    sc.monitor("floor", ground, "pit_floor", reduce="profile", along="x")
+    stages = [Stage("excavate", remove=[(fill, "fill")]),
+              Stage("build", add=[(wall, "wall"), (plate, "plate")], driver=dc.LoadControl(steps=2)),
+              Stage("fill", add=[(fill, "fill")])]
+    results = solve_stages(sc, stages, approach=approach, initial=[(ground, "ground"), (fill, "fill")])
+    return sc, results, ground, wall, pair
+
+
+def _wall_face_gap(wall, points: np.ndarray) -> np.ndarray:
+    """Distance of ``points`` from the wall's face on the side x > axis (half its depth from the
+    current axis, on the C¹ curve through the wall's nodes, as contact sees it), by brute force
+    over its segments."""
+    from dolfinx_corot.contact.kernels2d import smooth_gap
+    X, state = wall.model.nodes()
+    on_wall = (np.abs(X[:, 0] - 2.0) < 1e-9) & (X[:, 1] > 2.0 - 1e-9)  # (the beam model has the plate too)
+    x = X[on_wall] + state[on_wall, :2]
+    order = np.argsort(x[:, 1])
+    x = x[order]
+    out = []
+    for p in points:
+        best = np.inf
+        for k in range(len(x) - 1):
+            ext = [x[max(k - 1, 0)], x[k], x[k + 1], x[min(k + 2, len(x) - 1)]]
+            # the axis runs upwards: the body side (left) is x < axis, the fill on its right
+            g, xi, ok = smooth_gap(np.hstack([p] + ext)[None, :])
+            lo = -0.05 if k == 0 else -1e-9  # (a little beyond the free end, as contact allows)
+            if ok[0] and lo <= xi[0] <= 1.0 + 1e-9 and abs(g[0]) < abs(best):
+                best = g[0]
+        out.append(best - 0.5 * T_WALL)
+    return np.array(out)
+
+
+def test_mapping_of_new_fill_onto_the_deformed_configuration():
+    """Seed §3.1.2, approach II: before the fill appears, its nodes are mapped by the E = 1, ν = 0
+    sub-problem with the seed's boundary shifts. Asserted class by class: the slaves of the fill's
+    face lie on the deflected wall's face (to 1e-10 of the element size) — moved by up to 2 cm —;
+    nodes shared with the existing ground are shifted by U − U_e (U_e: the displacement at the end
+    of the excavation stage, read from a run stopped there), those shared with the plate by U;
+    free top nodes keep their elevation (zero vertical shift); the supported side keeps u_x = 0.
+    The fill appears stress-free (its stresses 1e-9 of the ground's), the contact carries nothing,
+    and the last stage leaves every node where it was at activation."""
+    sc, results, ground, wall, pair = _fill_against_a_wall("II")
+    mapping = results[2].mappings[0]
+    kinds = set(mapping.kind)
+    assert {"slave", "existing continuum", "structure", "free boundary", "support"} <= kinds
+    slave = mapping.kind == "slave"
+    gap = _wall_face_gap(wall, mapping.X[slave] + mapping.shift[slave])
+    assert np.abs(gap).max() < 1e-10 * 0.5
+    assert np.abs(mapping.shift[slave][:, 0]).max() > 0.01  # the wall moved: the face follows
+    # U − U_e on the ground, U on the plate (U: where the last stage ended, as it started)
+    U = _nodal(ground)
+    scale = max(np.abs(v).max() for v in U.values())
+    floor = results[0].profiles["floor"]  # the pit's floor at the end of the excavation: U_e
+    Ue = {tuple(np.round(x, 9)): np.array([ux, uy]) for x, ux, uy in
+          zip(floor.X, floor.column("ux")[-1], floor.column("uy")[-1])}
+    assert max(np.abs(v).max() for v in Ue.values()) > 1e-3  # the floor heaved
+    for kind, expected in (("existing continuum", lambda p: U[p] - Ue[p]), ("structure", lambda p: U[p])):
+        rows = np.flatnonzero(mapping.kind == kind)
+        assert len(rows)
+        for r in rows:
+            p = tuple(np.round(mapping.X[r], 9))
+            assert np.abs(mapping.shift[r] - expected(p)).max() < 1e-12 * scale
+    free = mapping.kind == "free boundary"
+    assert np.all(mapping.shift[free][:, 1] == 0.0)
+    assert np.all(mapping.shift[mapping.kind == "support"][:, 0] == 0.0)
+    # moved nodes sit at X + w now; the fill is stress-free; the contact carries nothing
+    moved = np.flatnonzero(mapping.moved)
+    assert len(moved) and all(np.abs(U[tuple(np.round(mapping.X[r], 9))] - mapping.shift[r]).max() < 1e-12 * scale
+                              for r in moved)
+    stress = _stresses(ground)
+    in_fill = (lambda p: p[0] > 2.1 and p[1] > 2.0)
+    ground_max = max(np.abs(v).max() for p, v in stress.items() if not in_fill(p))
+    assert max(np.abs(v).max() for p, v in stress.items() if in_fill(p)) < 1e-9 * ground_max
+    assert np.abs(pair.resultant(on="slaves")).max() < 1e-9 * Q_PLATE
+
+
+def test_contact_appearing_in_approach_one_takes_its_initial_gap_as_zero():
+    """Approach I (seed §3.1.2): the fill is placed on the mesh and its face meets the wall that
+    deflected away from it: the interface takes each slave's initial gap as zero (the gaps equal
+    the wall face's distance from the fill's face, up to 2 cm here), so the fill
+    appears stress-free and the last stage leaves every node where it was."""
+    sc, results, ground, wall, pair = _fill_against_a_wall("I")
+    itf = pair[0]
+    slaves = np.flatnonzero(itf.gap_cancelled)
+    assert len(slaves) >= 2
+    gaps = _wall_face_gap(wall, itf.slave.positions(comm)[slaves])  # (the fill does not move)
+    assert np.abs(itf.initial_gap[slaves] - gaps).max() < 1e-9
+    assert np.abs(gaps).max() > 0.01
+    stress = _stresses(ground)
+    in_fill = (lambda p: p[0] > 2.1 and p[1] > 2.0)
+    ground_max = max(np.abs(v).max() for p, v in stress.items() if not in_fill(p))
+    assert max(np.abs(v).max() for p, v in stress.items() if in_fill(p)) < 1e-9 * ground_max
+    assert np.abs(pair.resultant(on="slaves")).max() < 1e-9 * Q_PLATE

@@ -57,6 +57,10 @@ class Contribution:
     def add_tangent(self, add: AddBlocks) -> None:
         """Add the tangent of the last evaluation: add(dofs (k, n), K (k, n, n))."""
 
+    def start_stage(self, approach: str) -> None:
+        """A construction stage starts on this system (:mod:`dolfinx_corot.staging`, approach "I"
+        or "II"), before its first residual."""
+
     # -- Newton hooks --------------------------------------------------------------
     def before_step(self) -> None:
         """A load step (or its retry after a cut) starts."""

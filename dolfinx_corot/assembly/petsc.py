@@ -370,3 +370,28 @@ class LinearSolver:
 
     def destroy(self) -> None:
         destroy(self._fallback, self.P, self.ksp)
+
+
+def solve_constrained(comm, A: PETSc.Mat, rows: np.ndarray, values: np.ndarray) -> np.ndarray | None:
+    """x with x = ``values`` (owned entries) on the global ``rows`` and A x = 0 on the others
+    (MatZeroRowsColumns with the lifting of the imposed values, MUMPS LU); None when the
+    reduced matrix is singular. Destroys A."""
+    x, b = A.createVecs()
+    x.array[:] = values
+    b.set(0.0)
+    A.zeroRowsColumns(np.asarray(rows, dtype=PETSc.IntType), 1.0, x, b)
+    ksp = PETSc.KSP().create(comm)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    ksp.setOperators(A)
+    ksp.getPC().setFactorSetUpSolverType()
+    ksp.getPC().getFactorMatrix().setMumpsIcntl(24, 1)  # null pivots are reported
+    ksp.setUp()
+    out = None
+    if ksp.getPC().getFactorMatrix().getMumpsInfog(28) == 0:
+        ksp.solve(b, x)
+        out = x.array.copy()
+    destroy(ksp, A, x, b)
+    return out
+

@@ -496,10 +496,16 @@ class System:
         self.fext.copy(out)
         dolfinx.fem.petsc.set_bc(out, self.bcs, None, 0.0)
 
-    def parts_internal_force(self) -> np.ndarray:
-        """f_int of the parts alone (no contributions) at the current configuration, owned entries."""
-        self._assemble_parts()
+    def evaluate_internal_force(self) -> np.ndarray:
+        """f_int of the parts and the contributions (contact) at the current configuration, owned
+        entries."""
+        self._assemble_fint()
         return self.fint.array.copy()
+
+    def start_stage(self, approach: str) -> None:
+        """Tell the contributions that a construction stage starts (approach "I" or "II")."""
+        for c in self.contributions:
+            c.start_stage(approach)
 
     def ramp_loads_from(self, previous: np.ndarray | None) -> np.ndarray:
         """Stage loads: f_ext(λ) = F_prev + λ (F − F_prev), with F the external force assembled
@@ -632,6 +638,11 @@ class System:
         """Global system dofs of ``model``'s local unrolled dofs."""
         return self.A.getLGMap()[0].apply(np.asarray(local_dofs, dtype=PETSc.IntType)).astype(np.int64)
 
+    def touched_by_others(self, model) -> np.ndarray:
+        """(local blocks of ``model``) whether an existing element of another model touches the
+        node: never, with one model."""
+        return np.zeros(len(model.bending_blocks()), dtype=bool)
+
     def constrained_global_dofs(self) -> np.ndarray:
         """All constrained dofs (supports and prescribed motion), global numbering, on every rank."""
         own = [self.global_dofs(self.model, bc.dof_indices()[0][: bc.dof_indices()[1]]) for bc in self.bcs]
@@ -694,6 +705,20 @@ class CoupledSystem(System):
             for loc, arr in zip(self.layout.local, arrays):
                 f.array[loc] += arr
         vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+
+    def touched_by_others(self, model) -> np.ndarray:
+        """(local blocks of ``model``) whether an existing element of another model touches the node."""
+        i = self.model.models.index(model)
+        arrays = []
+        for k, m in enumerate(self.model.models):
+            a = np.zeros((len(m.bending_blocks()), m.ndof))
+            if k != i:
+                a[:] = 1.0
+                a[m.held_blocks()] = 0.0
+            arrays.append(a.ravel())
+        self._add_from_models(self._xglobal, arrays)
+        touched = self.model_array(model, self._xglobal) > 0.0
+        return touched.reshape(-1, model.ndof).any(axis=1)
 
     def model_array(self, model, vec: PETSc.Vec) -> np.ndarray:
         i = self.model.models.index(model)

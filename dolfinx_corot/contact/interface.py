@@ -128,6 +128,11 @@ class Interface:
         self.size = float(np.linalg.norm(both.max(axis=0) - both.min(axis=0)))
         self.touch = 1e-6 * self.h  # a gap below this keeps the penalty stiffness (no force)
         self.uzawa_updates = 0
+        # staged construction: the slaves and master segments that exist (None: all), and the
+        # initial gaps taken as zero (approach I, :meth:`cancel_initial_gaps`), added to the offsets
+        self.slave_on = self.segment_on = None
+        self.initial_gap = np.zeros(len(self.area))
+        self.gap_cancelled = np.zeros(len(self.area), dtype=bool)
 
     # -- binding to a system ---------------------------------------------------------
     def bind(self, system) -> None:
@@ -148,6 +153,93 @@ class Interface:
         self.had_contact = False
         self.band_used = 0
         self._virtual = None
+        self._update_existence()
+
+    def _update_existence(self) -> None:
+        """Which slaves and master segments exist (staged construction): a slave exists when an
+        existing facet of its surface touches it, a segment when its element exists. The
+        multipliers of slaves that do not exist are reset."""
+        slave, master = self.slave.existence(self.comm), self.master.existence(self.comm)
+        self.slave_on = None if slave is None else slave[1]
+        self.segment_on = None if master is None else master[0]
+        if self.slave_on is not None:
+            self.multiplier[~self.slave_on] = 0.0
+
+    def _existing_pairs(self, pairs: np.ndarray) -> np.ndarray:
+        keep = np.ones(len(pairs), dtype=bool)
+        if self.slave_on is not None:
+            keep &= self.slave_on[pairs[:, 0]]
+        if self.segment_on is not None:
+            keep &= self.segment_on[pairs[:, 1]]
+        return pairs[keep]
+
+    def cancel_initial_gaps(self, slaves: np.ndarray | None = None) -> int:
+        """Approach I of staged construction (seed §3.1.2): an interface that appears cancels the
+        initial deformation of the bodies it joins. Each existing slave (of ``slaves``, indices;
+        None: all) that finds an existing master (within the search margin) for the first time
+        takes its current gap — open or overlapping — as zero from now on (it is added to the
+        slave's offset). Returns how many slaves did so (all ranks)."""
+        xs, xm = self._positions(self.slave), self._positions(self.master)
+        self.anchor = None
+        self._search(xs, xm)
+        segment, mode, sides = self._assign(xs, xm, self.candidates)
+        s = self.mine[(segment[self.mine] >= 0) & ~self.gap_cancelled[self.mine]]
+        if slaves is not None:
+            s = s[np.isin(s, slaves)]
+        g = np.zeros(len(self.area))
+        done = np.zeros(len(self.area))
+        if len(s):
+            m = segment[s]
+            lam = np.zeros(len(s))
+            gs = np.zeros(len(s))
+            self._pair_kernels(xs, xm, s, m, mode, sides, self.ext[m], lam, np.full(len(s), self.penalty),
+                               self.touch, gs, np.zeros((len(s), 10)), np.zeros((len(s), 10, 10)),
+                               np.zeros((len(s), 10)))
+            g[s] = gs
+            done[s] = 1.0
+        g = self.comm.allreduce(g, op=MPI.SUM)
+        done = self.comm.allreduce(done, op=MPI.SUM) > 0.0
+        self.initial_gap[done] = g[done]
+        self.slave_offset[done] += g[done]
+        self.gap_cancelled |= done
+        self.anchor = None
+        return int(done.sum())
+
+    def project_slaves(self, slaves: np.ndarray) -> np.ndarray:
+        """(k, 2) positions of the slaves ``slaves`` (indices) moved onto the current existing master
+        surface at zero gap (its contact face: a beam's at half its depth), along the master's
+        normal from their current positions; NaN for a slave that finds no existing segment.
+        Collective (all ranks get the same)."""
+        self.comm = self.slave.part.comm
+        self._update_existence()
+        xs, xm = self._positions(self.slave), self._positions(self.master)
+        seg = self.master.facets
+        on = np.arange(len(seg)) if self.segment_on is None else np.flatnonzero(self.segment_on)
+        out = np.full((len(slaves), 2), np.nan)
+        if not len(on) or not len(slaves):
+            return out
+        pairs = np.array([(i, m) for i in range(len(slaves)) for m in on], dtype=np.int64)
+        near, _ = narrow_phase(xs[slaves], xm[seg[:, 0]], xm[seg[:, 1]], pairs)
+        for i, m in enumerate(near):
+            if m < 0:
+                continue
+            x = xs[slaves[i]].copy()
+            t = xm[seg[m, 1]] - xm[seg[m, 0]]
+            n = np.array([t[1], -t[0]]) / np.linalg.norm(t)  # outward: the body is on the left
+            ext = self.ext[m]
+            side = None
+            for _ in range(50):
+                g, _, ok = smooth_gap(np.hstack([x] + [xm[ext[j]] for j in range(4)])[None, :])
+                if not ok[0]:
+                    break
+                if side is None:
+                    side = -1.0 if (self.two_sided and g[0] < 0.0) else 1.0
+                gap = side * g[0] - self.slave_offset[slaves[i]] - self.master_offset[m]
+                x -= side * gap * n
+                if abs(gap) <= 1e-13 * self.h:
+                    out[i] = x
+                    break
+        return out
 
     def _global_dofs(self, surf, system) -> np.ndarray:
         """(n, gdim) global dofs of the surface's nodes' translations in ``system``, on every rank."""
@@ -170,6 +262,7 @@ class Interface:
         reach = self.margin + self.slave_offset.max(initial=0.0) + self.master_offset.max(initial=0.0)
         pairs = broad_phase(xs[self.mine], xm[seg[:, 0]], xm[seg[:, 1]], reach)
         pairs[:, 0] = self.mine[pairs[:, 0]]
+        pairs = self._existing_pairs(pairs)
         union = np.unique(np.vstack([self.candidates, pairs]), axis=0)
         grown = self.comm.allreduce(int(len(union) > len(self.candidates)), op=MPI.MAX)
         if grown:
@@ -524,6 +617,15 @@ class Contact(Contribution):
         for itf, (K, (s, m)) in zip(self.interfaces, self._blocks):
             if len(s):
                 add(_pair_dofs(itf, s, m), _positive_part(K) if self.project else K)
+
+    def start_stage(self, approach: str) -> None:
+        """Approach I: each slave meeting a master for the first time takes its gap as zero
+        (:meth:`Interface.cancel_initial_gaps`)."""
+        if approach == "I":
+            for itf in self.interfaces:
+                n = itf.cancel_initial_gaps()
+                if n:
+                    logger.info("contact '%s': %d slave(s) take their initial gap as zero (approach I)", itf.name, n)
 
     # -- Newton hooks -----------------------------------------------------------------
     def before_step(self) -> None:

@@ -22,6 +22,7 @@ from petsc4py import PETSc
 
 import dolfinx.fem
 import dolfinx.la
+import dolfinx.mesh
 
 from ..io.mesh import TaggedMesh
 from .groups import NodeGroup, gather_group
@@ -189,10 +190,31 @@ class Part:
         raise NotImplementedError(f"staged construction: {type(self).__name__} parts are not staged yet, only "
                                   "solids and 2D beams and bars")
 
+    def is_staged(self) -> bool:
+        """Whether the part has existence per element (staged construction)."""
+        return False
+
     def held_blocks(self) -> np.ndarray:
         """Local blocks (owned and ghost) of nodes that no existing element touches (staged
         construction); none by default."""
         return np.zeros(0, dtype=np.int32)
+
+    def touched_blocks(self, cells: np.ndarray) -> np.ndarray:
+        """(local blocks, owned and ghost) whether a cell of the local mask ``cells`` on any rank
+        touches the node."""
+        touched = np.ones(self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts, dtype=bool)
+        touched[self._untouched_blocks(np.flatnonzero(cells))] = False
+        return touched
+
+    def boundary_blocks(self) -> np.ndarray:
+        """(local blocks, owned and ghost) whether the node lies on the mesh's exterior boundary."""
+        mesh = self.V.mesh
+        fdim = mesh.topology.dim - 1
+        mesh.topology.create_connectivity(fdim, mesh.topology.dim)
+        facets = dolfinx.mesh.exterior_facet_indices(mesh.topology)
+        out = np.zeros(self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts, dtype=bool)
+        out[dolfinx.fem.locate_dofs_topological(self.V, fdim, facets)] = True
+        return out
 
     def _untouched_blocks(self, cells: np.ndarray) -> np.ndarray:
         """Local blocks (owned and ghost) that none of the local ``cells`` on any rank touches."""
@@ -265,11 +287,14 @@ class Part:
         """Add the loads with the given amplitude (None: those proportional to λ) at unit factor."""
         self._add_distributed_loads(b, amplitude)
         n_owned = self.V.dofmap.index_map.size_local
+        # staged construction: a point load acts once an existing element of the part touches its node
+        held = self.held_blocks() if self.is_staged() and self._point_loads else np.zeros(0, dtype=np.int32)
         with b.localForm() as bl:
             arr = bl.array.reshape(-1, self.ndof)
             for blocks, values, amp in self._point_loads:
                 if amp is amplitude:
-                    arr[blocks[blocks < n_owned], : len(values)] += values
+                    blocks = blocks[(blocks < n_owned) & ~np.isin(blocks, held)]
+                    arr[blocks, : len(values)] += values
 
     def _add_distributed_loads(self, b: PETSc.Vec, amplitude) -> None:
         """Tractions and body forces (solids); none by default."""

@@ -316,6 +316,9 @@ class Frame2D(AdditiveState, LineFrame):
         self.approach = approach
         self._forms = None
 
+    def is_staged(self) -> bool:
+        return self._existing is not None
+
     def cells_existing(self) -> np.ndarray:
         """(local cells, owned and ghost) whether each exists."""
         return self._existing.copy()
@@ -331,8 +334,8 @@ class Frame2D(AdditiveState, LineFrame):
         self._forms = None
 
     def held_blocks(self) -> np.ndarray:
-        if self._existing is None:
-            return np.zeros(0, dtype=np.int32)
+        """Nodes that no (existing) element of the part touches — also without stages: a mesh of
+        lines read from a model with solids holds the solids' nodes too."""
         return self._untouched_blocks(self._cells_active())
 
     def _staged_shift(self) -> bool:
@@ -378,7 +381,7 @@ class Frame2D(AdditiveState, LineFrame):
         EA, EI = props[:, 0], props[:, 1]
         half = 0.5 * np.sqrt(12.0 * EI / np.where(EA > 0.0, EA, 1.0)) * (EA > 0.0)
         return gather_surface(self, where, seg_blocks, self.V.tabulate_dof_coordinates(), offsets=half,
-                              two_sided=True, modulus=None)
+                              two_sided=True, modulus=None, cells=cells)
 
 
 @numba.njit(cache=True)

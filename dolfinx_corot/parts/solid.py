@@ -36,6 +36,7 @@ import dolfinx.fem
 import dolfinx.fem.petsc
 import dolfinx.la
 
+from ..assembly import petsc
 from ..continuum.kinematics import deformation_gradient
 from ..continuum.laws import first_piola, lame
 from ..io.mesh import TaggedMesh
@@ -102,6 +103,7 @@ class Solid(AdditiveState, Part):
         # every cell exists and the forms are those without stages
         self.existing: dolfinx.fem.Function | None = None
         self.activation_shift: dolfinx.fem.Function | None = None
+        self.activation_reference: dolfinx.fem.Function | None = None
         self.approach = "II"
 
     # -- building -------------------------------------------------------------
@@ -234,18 +236,19 @@ class Solid(AdditiveState, Part):
 
     # -- staged construction ----------------------------------------------------------
     def _staged_kinematics(self, u):
-        """Per cell, with its activation shift s (module dolfinx_corot.staging): the small strain
-        ε(u − s), or F with the Jacobian J₀ of the cell's reference over the mesh (None: the mesh):
-        approach I F = I + ∇(u − s) on the mesh; approach II the reference is X + s,
-        F = (I + ∇u)(I + ∇s)⁻¹, J₀ = I + ∇s."""
-        s = self.activation_shift
+        """Per cell, with its activation shift s and reference shift m (module
+        dolfinx_corot.staging): the small strain ε(u − s), or F with the Jacobian J₀ of the cell's
+        reference over the mesh (None: the mesh): approach I F = I + ∇(u − s) on the mesh;
+        approach II the reference is X + m and the current position X + m + u − s,
+        F = (I + ∇m + ∇(u − s)) J₀⁻¹, J₀ = I + ∇m (m = s unless the new continuum was mapped)."""
+        s, m = self.activation_shift, self.activation_reference
         I = ufl.Identity(self.gdim)
         if not self.large_rotations:
             return ufl.sym(ufl.grad(u - s)), None
         if self.approach == "I":
             return I + ufl.grad(u - s), None
-        J0 = I + ufl.grad(s)
-        return ufl.dot(I + ufl.grad(u), ufl.inv(J0)), J0
+        J0 = I + ufl.grad(m)
+        return ufl.dot(J0 + ufl.grad(u - s), ufl.inv(J0)), J0
 
     def _staged_integrand(self, u, v):
         """P(F) : ∇v per cell (:meth:`_staged_kinematics`); approach II at large rotations is
@@ -270,39 +273,93 @@ class Solid(AdditiveState, Part):
             cell = self.V.ufl_element().cell()
             family = "DQ" if cell.cellname() in ("quadrilateral", "hexahedron") else "DG"
             element = ufl.VectorElement(family, cell, self.degree)
-            self.activation_shift = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, element),
-                                                         name="activation_shift")
+            space = dolfinx.fem.FunctionSpace(mesh, element)
+            self.activation_shift = dolfinx.fem.Function(space, name="activation_shift")
+            self.activation_reference = dolfinx.fem.Function(space, name="activation_reference")
             self._forms = None
         self.approach = approach
+
+    def is_staged(self) -> bool:
+        return self.existing is not None
 
     def cells_existing(self) -> np.ndarray:
         """(local cells, owned and ghost) whether each exists."""
         return self.existing.x.array[self._cell_dof] > 0.5
 
-    def set_existing(self, exists: np.ndarray) -> None:
+    def set_existing(self, exists: np.ndarray, reference: np.ndarray | None = None) -> None:
         """Which local cells (owned and ghost) exist; cells that appear take the current
-        displacement of their nodes as their activation shift s (strain-free)."""
+        displacement of their nodes as their activation shift s (strain-free) and ``reference``
+        (local blocks × gdim, e.g. mapped by :meth:`map_new_cells`; None: s) as their reference
+        shift m."""
         new = exists & ~self.cells_existing()
         if new.any():
-            # s on the new cells' DG dofs = u at their nodes (the same node order per cell)
+            # s, m on the new cells' DG dofs = u, reference at their nodes (the same node order per cell)
             n = self.nodes_per_cell
             dg = self.activation_shift.function_space.dofmap.list.array.reshape(-1, n)[new].ravel()
             cg = self.V.dofmap.list.array.reshape(-1, n)[new].ravel()
-            self.activation_shift.x.array.reshape(-1, self.gdim)[dg] = self.state.x.array.reshape(-1, self.gdim)[cg]
+            u = self.state.x.array.reshape(-1, self.gdim)
+            self.activation_shift.x.array.reshape(-1, self.gdim)[dg] = u[cg]
+            ref = u if reference is None else np.asarray(reference).reshape(-1, self.gdim)
+            self.activation_reference.x.array.reshape(-1, self.gdim)[dg] = ref[cg]
         self.existing.x.array[self._cell_dof] = exists.astype(float)
+
+    def map_new_cells(self, new: np.ndarray, values: np.ndarray, imposed: np.ndarray) -> np.ndarray:
+        """The seed's mapping of new continuum onto the deformed configuration (§3.1.2, approach
+        II): the shift w of the nodes of the local cells ``new`` solving linear elasticity with
+        E = 1, ν = 0 on those cells alone, with w = ``values`` on the dofs where ``imposed``
+        (both local blocks × gdim, owned and ghost). Returns w (local blocks × gdim; the imposed
+        values elsewhere). Every dof of a new cell left free must be held by the imposed ones
+        (a new region with no imposed node in some direction is refused)."""
+        gdim, n = self.gdim, self.nodes_per_cell
+        imap = self.V.dofmap.index_map
+        n_owned = imap.size_local
+        blocks = self.V.dofmap.list.array.reshape(-1, n)
+        in_new = np.zeros(n_owned + imap.num_ghosts, dtype=bool)
+        in_new[blocks[new].ravel()] = True
+        flag = dolfinx.la.vector(imap)
+        flag.array[:] = in_new
+        flag.scatter_reverse(dolfinx.la.ScatterMode.add)
+        flag.scatter_forward()
+        in_new = flag.array > 0
+        fixed = np.asarray(imposed, dtype=bool).reshape(-1, gdim) | ~in_new[:, None]
+        Q = self.existing.function_space
+        indicator = dolfinx.fem.Function(Q)
+        indicator.x.array[self._cell_dof[new]] = 1.0
+        indicator.x.scatter_forward()
+        w, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
+        a = dolfinx.fem.form(indicator * ufl.inner(ufl.sym(ufl.grad(w)), ufl.sym(ufl.grad(v))) * ufl.dx)
+        A = dolfinx.fem.petsc.assemble_matrix(a)
+        A.assemble()
+        start = imap.local_range[0] * gdim
+        rows = start + np.flatnonzero(fixed[:n_owned].ravel())
+        solution = petsc.solve_constrained(self.comm, A, rows,
+                                           np.asarray(values, dtype=float).reshape(-1, gdim)[:n_owned].ravel())
+        singular = self.comm.allreduce(solution is None, op=MPI.LOR)
+        out = dolfinx.fem.Function(self.V)
+        if not singular:
+            out.x.array[: n_owned * gdim] = solution
+            out.x.scatter_forward()
+        if singular:
+            raise ValueError("mapping of new continuum (approach II): the cells added are not held — no node "
+                             "of them is shared with existing elements, a slave on an existing master, "
+                             "supported or on a free boundary in every direction")
+        return out.x.array.reshape(-1, gdim).copy()
 
     keeps_strains_without_displacements = True
 
     def reset_displacements(self) -> None:
         """Discard the displacement, keep the strains (a geostatic stage): each existing cell's
-        shift becomes s − u, so that its strain measure (of u − s, or F = (I + ∇u)(I + ∇s)⁻¹) is
+        shifts s and m become s − u and m − u, so that its strain measure (of u − s, or
+        F = (I + ∇m + ∇(u − s))(I + ∇m)⁻¹) is
         unchanged while u = 0. At small strain the stresses are kept exactly; at large strain the
         existing cells are referred to X − u (the mesh is the deformed state)."""
         exists = self.cells_existing()
         n = self.nodes_per_cell
         dg = self.activation_shift.function_space.dofmap.list.array.reshape(-1, n)[exists].ravel()
         cg = self.V.dofmap.list.array.reshape(-1, n)[exists].ravel()
-        self.activation_shift.x.array.reshape(-1, self.gdim)[dg] -= self.state.x.array.reshape(-1, self.gdim)[cg]
+        u = self.state.x.array.reshape(-1, self.gdim)[cg]
+        self.activation_shift.x.array.reshape(-1, self.gdim)[dg] -= u
+        self.activation_reference.x.array.reshape(-1, self.gdim)[dg] -= u
         self.state.x.array[:] = 0.0
 
     def cell_stress(self) -> np.ndarray:
@@ -377,6 +434,8 @@ class Solid(AdditiveState, Part):
                 if amp is amplitude:
                     tag = self.tmesh.groups[where][1]
                     term = ufl.inner(ufl.as_vector([float(c) for c in t]), v)
+                    if self.existing is not None:  # on the faces of existing cells
+                        term = self.existing * term
                     terms.append((term if area is None else area * term) * ds(tag))
         dx = ufl.Measure("dx", domain=self.V.mesh, subdomain_data=self.tmesh.cell_tags)
         for where, b, material_density, amp in self._body:
@@ -388,6 +447,8 @@ class Solid(AdditiveState, Part):
                     term = self.density * term
                 if self.existing is not None:
                     term = self.existing * term
+                    if self.large_rotations and self.approach == "II":  # per volume of the reference X + m
+                        term = ufl.det(ufl.Identity(self.gdim) + ufl.grad(self.activation_reference)) * term
                 terms.append((term if volume is None else volume * term) * measure)
         if not terms:
             return None
@@ -486,7 +547,7 @@ class Solid(AdditiveState, Part):
         c2v = mesh.topology.connectivity(2, 0)
         n_owned_cells = mesh.topology.index_map(2).size_local
         Xdof = self.V.tabulate_dof_coordinates()[:, :2]
-        seg_blocks, inner = [], 0
+        seg_blocks, seg_cells, inner = [], [], 0
         for f in facets:
             cells = f2c.links(f)
             if len(cells) != 1:
@@ -504,10 +565,11 @@ class Solid(AdditiveState, Part):
             if np.dot(0.5 * (Xdof[a] + Xdof[b]) - centroid, n) < 0.0:
                 a, b = b, a  # the body on the left of a -> b
             seg_blocks.append((a, b))
+            seg_cells.append(c)
         if self.comm.allreduce(inner, op=MPI.SUM):  # raised on every rank
             raise SurfaceError(f"contact surface '{where}': some of its lines lie inside the solid, "
                                "not on its boundary")
         E, nu = self.E.x.array, self.nu.x.array
         modulus = self.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN)
         return gather_surface(self, where, np.array(seg_blocks, dtype=np.int64).reshape(-1, 2), Xdof,
-                              modulus=modulus)
+                              modulus=modulus, cells=np.array(seg_cells, dtype=np.int32))

@@ -31,7 +31,9 @@ class Surface:
     offsets: (m,) distance of the contact surface from the facets (a beam's half depth, a
     shell's half thickness; 0 for solids); two_sided: contact on either side (beams, shells);
     modulus: the stiffness scale E/(1 − ν²) of the body for a default penalty (None: the part
-    has none to offer, e.g. a beam).
+    has none to offer, e.g. a beam);
+    cells: the local cell (element) of each of this rank's facets, in the order they were
+    gathered — what staged construction asks to know which facets exist.
     """
 
     part: object
@@ -45,6 +47,7 @@ class Surface:
     offsets: np.ndarray = field(default_factory=lambda: np.zeros(0))
     two_sided: bool = False
     modulus: float | None = None
+    cells: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int32))
 
     @property
     def gdim(self) -> int:
@@ -62,6 +65,17 @@ class Surface:
         for pos, vals in zip(comm.allgather(self.local), comm.allgather(u)):
             x[pos] += vals
         return x
+
+    def existence(self, comm) -> tuple[np.ndarray, np.ndarray] | None:
+        """(facets (m,), nodes (n,)) whether each facet's element exists and whether an existing
+        facet touches each node, on every rank; None when the part is not staged (all exist)."""
+        exists = self.part.cells_existing() if self.part.is_staged() else None
+        if exists is None:
+            return None
+        facet_on = np.concatenate(comm.allgather(exists[self.cells])).astype(bool)
+        node_on = np.zeros(len(self.X), dtype=bool)
+        node_on[self.facets[facet_on].ravel()] = True
+        return facet_on, node_on
 
     def node_offsets(self) -> np.ndarray:
         """(n,) the largest offset of the facets at each node."""
@@ -92,5 +106,6 @@ def gather_surface(part, name: str, facet_blocks: np.ndarray, Xdof: np.ndarray, 
     for pos, x in zip(comm.allgather(own_pos), comm.allgather(Xdof[own_blocks, :gdim])):
         X[pos] = x
     local_offsets = extra.pop("offsets", np.zeros(len(facet_blocks)))
+    extra["cells"] = np.asarray(extra.get("cells", np.zeros(len(facet_blocks))), dtype=np.int32)
     offsets = np.concatenate(comm.allgather(np.asarray(local_offsets, dtype=float)))
     return Surface(part, name, nv - 1, keys, X, facets, own_pos, own_blocks.astype(np.int32), offsets, **extra)

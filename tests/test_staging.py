@@ -15,6 +15,11 @@ comm = MPI.COMM_WORLD
 H, WIDTH, E, NU, RHO, G = 8.0, 1.0, 1.0e4, 0.25, 2.0, 10.0
 
 
+def _physical_group(dim: int, tags, tag: int, name: str) -> None:
+    gmsh.model.addPhysicalGroup(dim, tags, tag)
+    gmsh.model.setPhysicalName(dim, tag, name)
+
+
 def _column(n: int):
     """A column WIDTH × H of n layers (one quadrilateral each, shared nodes): cell groups layer1…n
     from the bottom, line groups base and sides, point group 'z<k>' at the left node of height k·h."""
@@ -39,9 +44,7 @@ def _column(n: int):
             gmsh.model.geo.mesh.setTransfiniteSurface(sf)
             gmsh.model.geo.mesh.setRecombine(2, sf)
         gmsh.model.geo.synchronize()
-        def group(dim, tags, tag, name):
-            gmsh.model.addPhysicalGroup(dim, tags, tag)
-            gmsh.model.setPhysicalName(dim, tag, name)
+        group = _physical_group
 
         for k, sf in enumerate(surfaces):
             group(2, [sf], k + 1, f"layer{k + 1}")
@@ -162,15 +165,18 @@ def test_bad_stage_input_is_named():
 @pytest.mark.parametrize("approach", ["I", "II"])
 def test_staged_tangent_matches_finite_differences(approach):
     """The tangent of a staged column at large strain — the top layer activated on the settled one,
-    its shift s ≠ 0 (approach II: F = (I + ∇u)(I + ∇s)⁻¹ over X + s) — against central differences
-    of the residual at a perturbed state, free dofs (1e-6 of its largest entry)."""
+    its shift s ≠ 0 and, for approach II, a reference shift m ≠ s as a mapping makes it
+    (F = (I + ∇m + ∇(u − s))(I + ∇m)⁻¹ over X + m) — against central differences of the residual at
+    a perturbed state, free dofs (1e-6 of its largest entry)."""
     sc, soil = _column_scene(2, large=True, modulus=1500.0)
     solve_stages(sc, [Stage(f"layer {k}", add=[(soil, f"layer{k}")]) for k in (1, 2)], approach=approach)
     model = soil.model
     assert np.abs(model.activation_shift.x.array).max() > 0.05  # the second layer's bottom had settled
+    rng = np.random.default_rng(5)
+    m = model.activation_reference.x.array
+    m[:] += rng.uniform(-0.05, 0.05, m.shape) * (np.abs(model.activation_shift.x.array) > 0.0)
     system = make_system(sc.model, solver="direct")
     try:
-        rng = np.random.default_rng(5)
         model.state.x.array[:] += rng.uniform(-0.02, 0.02, model.state.x.array.shape)
         K, Kfd = tangent_and_fd(system, model.state.x.array, 1.0)
         fixed = np.concatenate([bc.dof_indices()[0] for bc in system.bcs])
@@ -216,9 +222,7 @@ def _ground(with_pit: bool, n: int = 2, beams: bool = False):
             geo.mesh.setRecombine(2, sf)
         geo.synchronize()
 
-        def group(dim, tags, tag, name):
-            gmsh.model.addPhysicalGroup(dim, tags, tag)
-            gmsh.model.setPhysicalName(dim, tag, name)
+        group = _physical_group
 
         group(2, [s for k, s in surf.items() if beams or k != (0, 1)], 1, "ground")
         if with_pit and not beams:
@@ -474,9 +478,7 @@ def _pit_wall_plate():
             geo.mesh.setRecombine(2, sf)
         geo.synchronize()
 
-        def group(dim, tags, tag, name):
-            gmsh.model.addPhysicalGroup(dim, tags, tag)
-            gmsh.model.setPhysicalName(dim, tag, name)
+        group = _physical_group
 
         group(2, [s for (i, j), s in cells.items() if j == 0 or i == 0] + [upper], 1, "ground")
         group(2, [s for (i, j), s in cells.items() if j == 1 and i >= 2], 2, "fill")
@@ -606,3 +608,38 @@ def test_contact_appearing_in_approach_one_takes_its_initial_gap_as_zero():
     ground_max = max(np.abs(v).max() for p, v in stress.items() if not in_fill(p))
     assert max(np.abs(v).max() for p, v in stress.items() if in_fill(p)) < 1e-9 * ground_max
     assert np.abs(pair.resultant(on="slaves")).max() < 1e-9 * Q_PLATE
+
+
+def test_mapping_refuses_new_cells_that_nothing_holds():
+    """Approach II: a block added in the air (no node shared with existing elements, no support, no
+    slave) has nothing to map it horizontally: the stage is refused by name, on every rank."""
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("floating")
+        geo = gmsh.model.geo
+        surfaces = []
+        for y0 in (0.0, 2.0):
+            p = [geo.addPoint(x, y, 0.0) for x, y in ((0, y0), (1, y0), (1, y0 + 1), (0, y0 + 1))]
+            lines = [geo.addLine(p[k], p[(k + 1) % 4]) for k in range(4)]
+            surfaces.append(geo.addPlaneSurface([geo.addCurveLoop(lines)]))
+            if y0 == 0.0:
+                base = lines[0]
+            for c in lines:
+                geo.mesh.setTransfiniteCurve(c, 2)
+        for sf in surfaces:
+            geo.mesh.setTransfiniteSurface(sf)
+            geo.mesh.setRecombine(2, sf)
+        geo.synchronize()
+        _physical_group(2, [surfaces[0]], 1, "ground")
+        _physical_group(2, [surfaces[1]], 2, "block")
+        _physical_group(1, [base], 3, "base")
+        gmsh.model.mesh.generate(2)
+    tm = from_gmsh(gmsh.model, 2, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    sc = dc.Scene(large_rotations=True, linear_solver="direct")
+    soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+    sc.fix(soil, "base")
+    with pytest.raises(ValueError, match="mapping of new continuum .approach II.: the cells added are not held"):
+        solve_stages(sc, [Stage("block", add=[(soil, "block")])], approach="II", initial=[(soil, "ground")])

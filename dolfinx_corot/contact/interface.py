@@ -103,7 +103,7 @@ class Interface:
         # beams: contact on either side of the axis, at half the section's depth from it
         self.two_sided = self.master.two_sided
         self.master_offset = self.master.offsets
-        self.slave_offset = self.slave.node_offsets()
+        self.slave_face = self.slave.node_offsets()  # a beam's half depth at its slave nodes
         self.h = float(np.mean(np.linalg.norm(Xm[sm[:, 1]] - Xm[sm[:, 0]], axis=1)))
         if law.penalty is not None:
             if not law.penalty > 0.0:
@@ -155,6 +155,12 @@ class Interface:
         self._virtual = None
         self._update_existence()
 
+    @property
+    def slave_offset(self) -> np.ndarray:
+        """(n_slaves,) the distance of each slave's contact face from its node: a beam's half depth,
+        plus the initial gap taken as zero (staged construction, approach I)."""
+        return self.slave_face + self.initial_gap
+
     def _update_existence(self) -> None:
         """Which slaves and master segments exist (staged construction): a slave exists when an
         existing facet of its surface touches it, a segment when its element exists. The
@@ -200,7 +206,6 @@ class Interface:
         g = self.comm.allreduce(g, op=MPI.SUM)
         done = self.comm.allreduce(done, op=MPI.SUM) > 0.0
         self.initial_gap[done] = g[done]
-        self.slave_offset[done] += g[done]
         self.gap_cancelled |= done
         self.anchor = None
         return int(done.sum())
@@ -218,7 +223,7 @@ class Interface:
         out = np.full((len(slaves), 2), np.nan)
         if not len(on) or not len(slaves):
             return out
-        pairs = np.array([(i, m) for i in range(len(slaves)) for m in on], dtype=np.int64)
+        pairs = np.column_stack([np.repeat(np.arange(len(slaves)), len(on)), np.tile(on, len(slaves))])
         near, _ = narrow_phase(xs[slaves], xm[seg[:, 0]], xm[seg[:, 1]], pairs)
         for i, m in enumerate(near):
             if m < 0:
@@ -708,6 +713,8 @@ class Contact(Contribution):
         out = {}
         for k, itf in enumerate(self.interfaces):
             out[f"{k}_multiplier"] = itf.multiplier.copy()
+            out[f"{k}_initial_gap"] = itf.initial_gap.copy()
+            out[f"{k}_gap_cancelled"] = itf.gap_cancelled.astype(float)
             cand = np.concatenate(self.comm.allgather(itf.candidates)).reshape(-1, 2)
             out[f"{k}_candidates"] = np.unique(cand, axis=0)
             if itf.anchor is not None:
@@ -721,6 +728,9 @@ class Contact(Contribution):
                 raise ValueError(f"contact '{itf.name}': the checkpoint holds {len(lam)} slave nodes, the "
                                  f"interface has {len(itf.multiplier)}")
             itf.multiplier[:] = lam
+            if f"{k}_initial_gap" in arrays:  # (staged construction, approach I)
+                itf.initial_gap[:] = arrays[f"{k}_initial_gap"]
+                itf.gap_cancelled[:] = arrays[f"{k}_gap_cancelled"] > 0.5
             cand = arrays[f"{k}_candidates"].astype(np.int64).reshape(-1, 2)
             itf.candidates = cand[np.isin(cand[:, 0], itf.mine)]
             itf.pairs_changed = True

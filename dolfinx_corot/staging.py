@@ -75,9 +75,12 @@ class Stage:
     reset_displacements: bool = False
 
 
-def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: Sequence = ()) -> list[Result]:
+def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: Sequence = (),
+                 on_step=None) -> list[Result]:
     """Run ``stages`` in turn on ``scene``; ``initial`` = [(solid part, cell group), …] exist from
-    the start (the rest of each staged solid does not, until a stage adds it). Returns one
+    the start (the rest of each staged solid does not, until a stage adds it). ``on_step(stage,
+    row)`` is called after every converged step with the :class:`Stage` and the step's history
+    row (e.g. to draw the configuration at the end of each stage). Returns one
     :class:`Result` per stage. A stage that fails raises :class:`ConvergenceError` whose
     ``results`` hold the stages before it and the converged steps of the failed one (its
     ``result``); the configuration is left at its last converged state.
@@ -146,8 +149,10 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
             if stage.reset_displacements:
                 _check_resettable(system, staged, stage)
             try:
-                result = solve(scene, stage.driver, system=system)
+                step = None if on_step is None else (lambda row, stage=stage: on_step(stage, row))
+                result = solve(scene, stage.driver, system=system, on_step=step)
             except ConvergenceError as err:
+                err.result.mappings = mappings
                 err.results = results + [err.result]
                 raise
             result.mappings = mappings
@@ -275,10 +280,12 @@ def _touched_by_structures(scene, model) -> np.ndarray:
 
 
 def _check_resettable(system, staged: dict, stage: Stage) -> None:
-    """Only staged parts that keep their strains without their displacements (solids) can be reset."""
+    """Only staged parts that keep their strains without their displacements (solids), or none of
+    whose elements exists yet, can be reset."""
     for model in system.models:
-        if id(model) not in staged or not model.keeps_strains_without_displacements:
+        if id(model) not in staged or not model.can_reset_displacements():
             kinds = ", ".join(sorted({f"{p.kind} '{p.name}'" for p in model.parts}))
-            why = "is not staged" if id(model) not in staged else "cannot keep its strains without its displacements"
+            why = "is not staged" if id(model) not in staged else \
+                "exists and cannot keep its strains without its displacements"
             raise NotImplementedError(f"solve_stages: stage '{stage.name}' discards the displacements, but {kinds} "
                                       f"{why} (only staged solids can: put the structures in later stages)")

@@ -115,6 +115,42 @@ def test_node_to_vertex_force_and_tangent_match_finite_differences(multiplier):
         assert np.abs(K[0] - fd_K).max() < 1e-6 * np.abs(K[0]).max()
 
 
+@pytest.mark.parametrize("multiplier", [0.0, 2.0])
+def test_node_to_vertex_around_a_beam_kink_matches_finite_differences(multiplier):
+    """A beam's kink (two-sided master): the face is the circle of radius r (the offsets: half the
+    beam's depth plus the slave's) around the vertex, on the slave's side — the interface passes
+    the direction vertex → slave as the normal and r as the offset: g = |x_s − x_v| − r."""
+    from dolfinx_corot.contact.kernels2d import node_to_vertex
+
+    rng = np.random.default_rng(5)
+    for trial in range(6):
+        xv = rng.uniform(-1, 1, 2)
+        r = rng.uniform(0.05, 0.2)
+        d = rng.normal(size=2)
+        d *= rng.uniform(0.5, 0.95) * r / np.linalg.norm(d)  # within the rounded face: g < 0
+        x0 = np.concatenate([xv + d, xv])
+        eps, area, lam = np.array([rng.uniform(10, 1000)]), np.array([0.7]), np.array([multiplier])
+
+        def ev(x, tangent=False):
+            return node_to_vertex(x[None, 0:2], x[None, 2:4], (x[0:2] - x[2:4])[None], np.array([r]), lam, eps,
+                                  area, tangent)
+
+        g, p, f, K = ev(x0, True)
+        assert abs(g[0] - (np.linalg.norm(d) - r)) < 1e-14 and p[0] > 0
+        h = 1e-7
+        fd_K = np.zeros((4, 4))
+        fd_f = np.zeros(4)
+        for j in range(4):
+            e = np.zeros(4)
+            e[j] = h
+            fd_K[:, j] = (ev(x0 + e)[2][0] - ev(x0 - e)[2][0]) / (2 * h)
+            Wp = area[0] / (2 * eps[0]) * ev(x0 + e)[1][0] ** 2
+            Wm = area[0] / (2 * eps[0]) * ev(x0 - e)[1][0] ** 2
+            fd_f[j] = (Wp - Wm) / (2 * h)
+        assert np.abs(f[0] - fd_f).max() < 1e-6 * np.abs(f[0]).max()
+        assert np.abs(K[0] - fd_K).max() < 1e-6 * np.abs(K[0]).max()
+
+
 def test_node_to_vertex_continues_node_to_segment_at_the_segment_end():
     """At ξ = 1 the vertex gap, force and normal stiffness equal the segment's."""
     from dolfinx_corot.contact.kernels2d import node_to_vertex

@@ -94,8 +94,9 @@ class Interface:
             raise ContactError(f"contact of surface '{slaves[1]}' with itself is not supported: give two "
                                "surfaces (self-contact is not implemented)")
         self.slave_spec, self.master_spec, self.law = slaves, masters, law
-        self.slave = slaves[0].model.surface(slaves[1])
-        self.master = masters[0].model.surface(masters[1])
+        # a solid region's face (its lines may border cells of another region of the mesh)
+        self.slave = slaves[0].model.surface(slaves[1], body=slaves[0].name or None)
+        self.master = masters[0].model.surface(masters[1], body=masters[0].name or None)
         self.name = f"{slaves[1]} -> {masters[1]}"
         # slaves: all nodes of the slave group; their tributary lengths on the slave boundary
         self.area = _tributary_lengths(self.slave.X, self.slave.facets)
@@ -223,28 +224,54 @@ class Interface:
         out = np.full((len(slaves), 2), np.nan)
         if not len(on) or not len(slaves):
             return out
-        pairs = np.column_stack([np.repeat(np.arange(len(slaves)), len(on)), np.tile(on, len(slaves))])
-        near, _ = narrow_phase(xs[slaves], xm[seg[:, 0]], xm[seg[:, 1]], pairs)
-        for i, m in enumerate(near):
-            if m < 0:
-                continue
-            x = xs[slaves[i]].copy()
-            t = xm[seg[m, 1]] - xm[seg[m, 0]]
-            n = np.array([t[1], -t[0]]) / np.linalg.norm(t)  # outward: the body is on the left
-            ext = self.ext[m]
-            side = None
-            for _ in range(50):
-                g, _, ok = smooth_gap(np.hstack([x] + [xm[ext[j]] for j in range(4)])[None, :])
-                if not ok[0]:
-                    break
-                if side is None:
-                    side = -1.0 if (self.two_sided and g[0] < 0.0) else 1.0
-                gap = side * g[0] - self.slave_offset[slaves[i]] - self.master_offset[m]
-                x -= side * gap * n
-                if abs(gap) <= 1e-13 * self.h:
-                    out[i] = x
-                    break
+        a, b = xm[seg[on, 0]], xm[seg[on, 1]]
+        ab = b - a
+        for i, k in enumerate(slaves):
+            # of the nearest segments, the one whose projection falls within it, or least beyond
+            # its ends (at a sharp convex corner of the master the point is as near to both
+            # segments' ends, and the projection on the wrong one lands far beyond it)
+            t = np.clip(np.einsum("ij,ij->i", xs[k] - a, ab) / np.einsum("ij,ij->i", ab, ab), 0.0, 1.0)
+            dist = np.linalg.norm(xs[k] - a - t[:, None] * ab, axis=1)
+            best = np.inf
+            nearest = on[np.argsort(dist, kind="stable")[:4]]
+            for m in nearest:
+                x, xi = self._project_on_segment(xs[k], k, m, xm)
+                if x is not None and max(-xi, xi - 1.0, 0.0) < best:
+                    best, out[i] = max(-xi, xi - 1.0, 0.0), x
+                    if best == 0.0:
+                        break
+            if best > self.XI_TOLERANCE:
+                # outside a convex corner, beyond both segments: onto the corner's face (the
+                # vertex, or the circle of the offsets around it)
+                m = nearest[0]
+                ends = xm[seg[m]]
+                v = ends[np.argmin(np.linalg.norm(ends - xs[k], axis=1))]
+                d = xs[k] - v
+                r = self.slave_offset[k] + self.master_offset[m]
+                out[i] = v + (r * d / np.linalg.norm(d) if np.linalg.norm(d) > 0.0 else 0.0)
         return out
+
+    def _project_on_segment(self, point: np.ndarray, k: int, m: int, xm: np.ndarray):
+        """``point`` (slave ``k``) moved along master segment ``m``'s normal onto its contact face
+        (the C¹ curve, offsets included) at zero gap: (position, local coordinate ξ on the
+        segment), or (None, None) if the iteration fails."""
+        seg = self.master.facets
+        t = xm[seg[m, 1]] - xm[seg[m, 0]]
+        n = np.array([t[1], -t[0]]) / np.linalg.norm(t)  # outward: the body is on the left
+        ext = self.ext[m]
+        x, side = point.copy(), None
+        for _ in range(50):
+            g, xi, ok = smooth_gap(np.hstack([x] + [xm[ext[j]] for j in range(4)])[None, :])
+            if not ok[0]:
+                return None, None
+            if side is None:
+                side = -1.0 if (self.two_sided and g[0] < 0.0) else 1.0
+            gap = side * g[0] - self.slave_offset[k] - self.master_offset[m]
+            x -= side * gap * n
+            if abs(gap) <= 1e-13 * self.h:
+                _, xi, _ = smooth_gap(np.hstack([x] + [xm[ext[j]] for j in range(4)])[None, :])
+                return x, float(xi[0])
+        return None, None
 
     def _global_dofs(self, surf, system) -> np.ndarray:
         """(n, gdim) global dofs of the surface's nodes' translations in ``system``, on every rank."""
@@ -356,7 +383,11 @@ class Interface:
                 if not len(i):
                     continue
                 v = ext[i, k]
-                gv, _, fv, Kv = node_to_vertex(xs[s[i]], xm[v], normals[v], self.slave_offset[s[i]], lam[i],
+                # a beam master (either side of its axis): the side is the slave's, the face half
+                # the beam's depth around its kink
+                normal_v = xs[s[i]] - xm[v] if self.two_sided else normals[v]
+                offset = self.slave_offset[s[i]] + self.master_offset[m[i]]
+                gv, _, fv, Kv = node_to_vertex(xs[s[i]], xm[v], normal_v, offset, lam[i],
                                                eps[i], self.area[s[i]], True, touch)
                 idx = np.array([0, 1, 2 * k + 2, 2 * k + 3])
                 g[i] = gv
@@ -389,7 +420,8 @@ class Interface:
             segment[pairs[first, 0]] = pairs[first, 1]
             sides[pairs[first, 0]] = side[first]
         # slaves without a projection: the closest point of the straight surface, if it is a sharp
-        # vertex shared by two segments (outside a convex corner) within the search margin
+        # vertex shared by two segments (outside a convex corner) within the search margin; a
+        # beam's kink is rounded by its thickness (the face at half its depth around the vertex)
         rest = pairs[segment[pairs[:, 0]] < 0]
         if len(rest):
             seg = self.master.facets
@@ -398,9 +430,8 @@ class Interface:
             m = np.maximum(near, 0)
             vertex = seg[m, end]
             sharp = np.where(end == 0, self.ext[m, 0] == self.ext[m, 1], self.ext[m, 3] == self.ext[m, 2])
-            close = np.linalg.norm(xs - xm[vertex], axis=1) < self.margin
+            close = np.linalg.norm(xs - xm[vertex], axis=1) - self.slave_offset - self.master_offset[m] < self.margin
             corner = (near >= 0) & ((t < 0.0) | (t > 1.0)) & (self.valence[vertex] >= 2) & sharp & close
-            corner &= not self.two_sided  # a beam's kinks are rounded by its thickness: not modelled
             segment[corner] = near[corner]
             mode[corner] = 1 + end[corner]
         return segment, mode, sides

@@ -205,3 +205,101 @@ def ring(radius: float, elements: int, centre=(0.0, 0.0), name: str = "ring",
     q = elements // 4
     return from_arrays(x, cells, name, point_groups={"springline": np.array([0]), "crown": np.array([q]),
                                                       "invert": np.array([3 * q])}, comm=comm)
+
+
+def box_in_pit(width: float, height: float, pit_width: float, pit_depth: float, span: float, rise: float,
+               thickness: float, layers_beside: int, layers_above: int, size: float,
+               comm: MPI.Comm = MPI.COMM_WORLD) -> tuple[TaggedMesh, TaggedMesh]:
+    """Half of a box structure built in a pit and backfilled (symmetry plane x = 0), meshed with
+    structured quadrilaterals of about ``size``; returns (solid mesh, line mesh of the same nodes).
+
+    The ground [0, width] × [0, height] has a pit [0, pit_width/2] × [y_f, height], y_f = height −
+    pit_depth. The structure's axis: a bottom slab on the pit floor y = y_f, x ∈ [0, span/2], a
+    wall x = span/2 and a roof y = y_f + rise (the slab shares the floor's nodes). Its outer faces,
+    half the ``thickness`` off the axis, are lines of the mesh: the cells inside them ('core':
+    the structure's interior and half its thickness) are excavated with the pit and never
+    refilled; the fill is the rest of the pit, in layers from the floor up to the roof's face
+    (``layers_beside``) and from there to the surface (``layers_above``).
+
+    Cell groups: 'ground', 'core', 'layer_1' … 'layer_n' (bottom up) and 'fill' (all layers).
+    Line groups: 'base' (y = 0), 'sides' (x = width), 'symmetry' (x = 0), 'surface' (y = height,
+    beyond the pit), 'fill_top' (y = height, over the pit), 'pit_floor' (y = y_f beside the
+    structure), 'pit_wall' (x = pit_width/2), 'slab', 'frame' (wall and roof axis), 'fill_face' (the
+    structure's outer face: wall and roof). Points: 'slab_centre', 'roof_centre', 'corner' (wall
+    and roof), 'surface_centre'."""
+    import gmsh
+
+    b, a, t = span / 2.0, pit_width / 2.0, thickness
+    y_f = height - pit_depth
+    x_face, y_roof, y_face = b + t / 2.0, y_f + rise, y_f + rise + t / 2.0
+    if not (0.0 < t < span and x_face < a < width and 0.0 < y_f and y_face < height):
+        raise ValueError(f"box_in_pit: the structure (span {span}, rise {rise}, thickness {t}) must lie in the "
+                         f"pit ({pit_width} wide, {pit_depth} deep) inside the ground {width} × {height}")
+    if layers_beside < 1 or layers_above < 1:
+        raise ValueError("box_in_pit: at least one layer beside the structure and one above it")
+    beside = list(np.linspace(y_f, y_face, layers_beside + 1))
+    above = list(np.linspace(y_face, height, layers_above + 1))
+    breaks = beside[:-1] + above
+    xs = [0.0, b, x_face, a, width]
+    ys = sorted(set(np.round([0.0, y_roof] + breaks, 12)))
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("box_in_pit")
+        geo = gmsh.model.geo
+        nx, ny = len(xs), len(ys)
+        pts = {(i, j): geo.addPoint(xs[i], ys[j], 0.0) for i in range(nx) for j in range(ny)}
+        hor = {(i, j): geo.addLine(pts[i, j], pts[i + 1, j]) for i in range(nx - 1) for j in range(ny)}
+        ver = {(i, j): geo.addLine(pts[i, j], pts[i, j + 1]) for i in range(nx) for j in range(ny - 1)}
+        for (i, j), c in hor.items():
+            geo.mesh.setTransfiniteCurve(c, max(1, int(round((xs[i + 1] - xs[i]) / size))) + 1)
+        for (i, j), c in ver.items():
+            geo.mesh.setTransfiniteCurve(c, max(1, int(round((ys[j + 1] - ys[j]) / size))) + 1)
+        groups = {"ground": [], "core": []}
+        layers = [[] for _ in range(len(breaks) - 1)]
+        for i in range(nx - 1):
+            for j in range(ny - 1):
+                loop = geo.addCurveLoop([hor[i, j], ver[i + 1, j], -hor[i, j + 1], -ver[i, j]])
+                sf = geo.addPlaneSurface([loop])
+                geo.mesh.setTransfiniteSurface(sf)
+                geo.mesh.setRecombine(2, sf)
+                xm, ym = 0.5 * (xs[i] + xs[i + 1]), 0.5 * (ys[j] + ys[j + 1])
+                if xm > a or ym < y_f:
+                    groups["ground"].append(sf)
+                elif xm < x_face and ym < y_face:
+                    groups["core"].append(sf)
+                else:
+                    layers[int(np.searchsorted(breaks, ym)) - 1].append(sf)
+        geo.synchronize()
+        x_at, y_at = (lambda v: xs.index(v)), (lambda v: int(np.argmin(np.abs(np.array(ys) - v))))
+        j_f, j_roof, j_face, j_top = y_at(y_f), y_at(y_roof), y_at(y_face), ny - 1
+        lines = {
+            "base": [hor[i, 0] for i in range(nx - 1)],
+            "sides": [ver[nx - 1, j] for j in range(ny - 1)],
+            "symmetry": [ver[0, j] for j in range(ny - 1)],
+            "surface": [hor[i, j_top] for i in range(x_at(a), nx - 1)],
+            "fill_top": [hor[i, j_top] for i in range(x_at(a))],
+            "pit_floor": [hor[x_at(x_face), j_f]],
+            "pit_wall": [ver[x_at(a), j] for j in range(j_f, ny - 1)],
+            "slab": [hor[0, j_f]],
+            "frame": [ver[x_at(b), j] for j in range(j_f, j_roof)] + [hor[0, j_roof]],
+            "fill_face": [ver[x_at(x_face), j] for j in range(j_f, j_face)] + [hor[0, j_face], hor[1, j_face]],
+        }
+        named = {name: (2, tags) for name, tags in groups.items()}
+        named.update({f"layer_{k + 1}": (2, tags) for k, tags in enumerate(layers)})
+        named.update({name: (1, tags) for name, tags in lines.items()})
+        named.update({"slab_centre": (0, [pts[0, j_f]]), "roof_centre": (0, [pts[0, j_roof]]),
+                      "corner": (0, [pts[x_at(b), j_roof]]), "surface_centre": (0, [pts[0, j_top]])})
+        for name, (dim, tags) in named.items():
+            tag = gmsh.model.addPhysicalGroup(dim, list(tags))
+            gmsh.model.setPhysicalName(dim, tag, name)
+        gmsh.model.mesh.generate(2)
+    try:
+        model = gmsh.model if comm.rank == 0 else None
+        solid = from_gmsh(model, 2, comm=comm)
+        lines_mesh = from_gmsh(model, 2, comm=comm, dim=1)
+    finally:
+        if comm.rank == 0:
+            gmsh.finalize()
+    solid.add_cell_group("fill", lambda x: (x[0] < a) & (x[1] > y_f) & ~((x[0] < x_face) & (x[1] < y_face)))
+    return solid, lines_mesh

@@ -233,9 +233,20 @@ class Part:
     #: (:meth:`reset_displacements`; staged solids)
     keeps_strains_without_displacements = False
 
+    def can_reset_displacements(self) -> bool:
+        """Whether a geostatic stage may discard this part's displacements now: it keeps its strains
+        without them, or it is staged and none of its elements exists yet (nothing to keep)."""
+        if self.keeps_strains_without_displacements:
+            return True
+        return self.is_staged() and not self.comm.allreduce(bool(self.cells_existing().any()), op=MPI.LOR)
+
     def reset_displacements(self) -> None:
-        raise NotImplementedError(f"{type(self).__name__} parts cannot discard their displacements and keep "
-                                  "their strains")
+        """Discard the displacements (a staged part none of whose elements exists yet: its nodes
+        shared with a solid follow the solid's reset)."""
+        if not self.can_reset_displacements():
+            raise NotImplementedError(f"{type(self).__name__} parts cannot discard their displacements and keep "
+                                      "their strains")
+        self.state.x.array[:] = 0.0
 
     def _fixed_blocks(self) -> np.ndarray:
         """Blocks whose non-translational dofs have no stiffness (fixed); none by default."""
@@ -394,8 +405,33 @@ class Part:
         state = self.state.x.array.reshape(-1, self.state_size)[:n_owned]
         return np.concatenate(self.comm.allgather(X)), np.concatenate(self.comm.allgather(state))
 
-    def surface(self, where: str) -> Surface:
-        """The contact surface of group ``where`` (parts that have none refuse)."""
+    def _cells_active(self) -> np.ndarray:
+        """Local cells (owned and ghost) with elements of this model (all by default)."""
+        cmap = self.V.mesh.topology.index_map(self.V.mesh.topology.dim)
+        return np.ones(cmap.size_local + cmap.num_ghosts, dtype=bool)
+
+    def cell_shapes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """For drawing: (X (cells, vertices, gdim) the initial positions of the vertices of every
+        owned cell, u (cells, vertices, gdim) their displacement, exists (cells,) whether the cell
+        has an existing element), on every rank, rank by rank. Quadrilateral vertices in the
+        order of their outline."""
+        mesh = self.V.mesh
+        tdim = mesh.topology.dim
+        nv = {"interval": 2, "triangle": 3, "quadrilateral": 4, "tetrahedron": 4,
+              "hexahedron": 8}[mesh.topology.cell_name()]
+        n_owned = mesh.topology.index_map(tdim).size_local
+        blocks = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)[:n_owned, :nv]
+        if mesh.topology.cell_type == dolfinx.mesh.CellType.quadrilateral:
+            blocks = blocks[:, [0, 1, 3, 2]]
+        X = self.V.tabulate_dof_coordinates()[:, : self.gdim][blocks]
+        u = self.state.x.array.reshape(-1, self.state_size)[:, : self.gdim][blocks]
+        exists = (self.cells_existing() if self.is_staged() else self._cells_active())[:n_owned]
+        gather = (lambda a: np.concatenate(self.comm.allgather(a)))
+        return gather(X), gather(u), gather(exists)
+
+    def surface(self, where: str, body: str | None = None) -> Surface:
+        """The contact surface of group ``where`` (parts that have none refuse); ``body``: the
+        region whose face it is, where the group's lines separate two regions of one mesh."""
         raise SurfaceError(f"contact surface '{where}': {self.kind_name} parts in {self.gdim}D are not supported "
                            "as contact surfaces so far (2D solids and 2D beams are)")
 

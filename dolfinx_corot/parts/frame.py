@@ -371,7 +371,7 @@ class Frame2D(AdditiveState, LineFrame):
                                   self.large_rotations, F, K)
         return cells, F
 
-    def surface(self, where: str) -> Surface:
+    def surface(self, where: str, body: str | None = None) -> Surface:
         """The beams of line group ``where`` as a two-sided contact surface: the axis offset by half
         the section's depth √(12 EI/EA)/2 on either side (exact for rectangles; 0 for bars)."""
         cells = self.tmesh.cells(where)

@@ -526,11 +526,14 @@ class Solid(AdditiveState, Part):
         return f.x.array.copy()
 
     # -- contact surface -------------------------------------------------------------
-    def surface(self, where: str) -> Surface:
+    def surface(self, where: str, body: str | None = None) -> Surface:
         """The boundary lines of facet group ``where`` of a linear 2D solid, oriented with the body on
-        the left; its stiffness scale is the smallest plane-strain modulus E/(1 − ν²) of the solid."""
+        the left; its stiffness scale is the smallest plane-strain modulus E/(1 − ν²) of the solid.
+        ``body`` (a cell group): a line between a cell of ``body`` and one of another region is the
+        face of the ``body`` cell (e.g. a fill's face along a structure, on cells excavated before
+        the fill appears); lines with cells of the solid on both sides otherwise are refused."""
         if self.gdim != 2:
-            return super().surface(where)
+            return super().surface(where, body)
         if self.degree != 1:
             raise SurfaceError(f"contact surface '{where}': node-to-segment contact needs linear solids "
                                f"(degree 1); this solid has degree {self.degree}")
@@ -547,9 +550,16 @@ class Solid(AdditiveState, Part):
         c2v = mesh.topology.connectivity(2, 0)
         n_owned_cells = mesh.topology.index_map(2).size_local
         Xdof = self.V.tabulate_dof_coordinates()[:, :2]
+        in_body = None
+        if body:
+            in_body = np.zeros(mesh.topology.index_map(2).size_local + mesh.topology.index_map(2).num_ghosts,
+                               dtype=bool)
+            in_body[tm.cells(body)] = True
         seg_blocks, seg_cells, inner = [], [], 0
         for f in facets:
             cells = f2c.links(f)
+            if len(cells) == 2 and in_body is not None and in_body[cells].sum() == 1:
+                cells = cells[in_body[cells]]
             if len(cells) != 1:
                 inner += 1
                 continue
@@ -567,7 +577,8 @@ class Solid(AdditiveState, Part):
             seg_blocks.append((a, b))
             seg_cells.append(c)
         if self.comm.allreduce(inner, op=MPI.SUM):  # raised on every rank
-            raise SurfaceError(f"contact surface '{where}': some of its lines lie inside the solid, "
+            side = f" (between two cells of '{body}' or of other regions)" if body else ""
+            raise SurfaceError(f"contact surface '{where}': some of its lines lie inside the solid{side}, "
                                "not on its boundary")
         E, nu = self.E.x.array, self.nu.x.array
         modulus = self.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN)

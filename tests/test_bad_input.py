@@ -90,3 +90,13 @@ def test_nan_coordinates_are_refused_at_set_up():
     tm = from_arrays(pts, np.array([[0, 1], [1, 2]]), "beam", comm=comm)
     with pytest.raises(ValueError, match="node coordinates that are not finite"):
         dc.Scene().add_beam(tm, "beam", section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(1.0))
+
+
+def test_box_in_pit_refuses_a_structure_outside_its_pit():
+    """gmsh_models.box_in_pit: a structure wider than the pit (or no layer) is refused by name."""
+    from dolfinx_corot.io.gmsh_models import box_in_pit
+
+    with pytest.raises(ValueError, match="the structure .* must lie in the pit"):
+        box_in_pit(12.0, 8.0, 4.0, 4.0, 4.0, 2.0, 0.2, 2, 2, 0.5)
+    with pytest.raises(ValueError, match="at least one layer beside the structure"):
+        box_in_pit(12.0, 8.0, 8.0, 4.0, 4.0, 2.0, 0.2, 0, 2, 0.5)

@@ -82,6 +82,21 @@ def test_separated_pair_is_inactive():
     assert g[0] == pytest.approx(0.1) and p[0] == 0 and not f.any() and not K.any() and W[0] == 0
 
 
+def _check_vertex_pair_by_fd(ev, x0, f, K, area, eps):
+    """f = ∂Φ/∂x (Φ = A/(2ε) p², the penalty potential) and K = ∂f/∂x of a node-to-vertex pair
+    ``ev(x) -> (g, p, f, K)`` against central differences at x0."""
+    h = 1e-7
+    fd_K = np.zeros((4, 4))
+    fd_f = np.zeros(4)
+    for j in range(4):
+        e = np.zeros(4)
+        e[j] = h
+        fd_K[:, j] = (ev(x0 + e)[2][0] - ev(x0 - e)[2][0]) / (2 * h)
+        fd_f[j] = area / (2 * eps) * (ev(x0 + e)[1][0] ** 2 - ev(x0 - e)[1][0] ** 2) / (2 * h)
+    assert np.abs(f - fd_f).max() < 1e-6 * np.abs(f).max()
+    assert np.abs(K - fd_K).max() < 1e-6 * np.abs(K).max()
+
+
 @pytest.mark.parametrize("multiplier", [0.0, 2.0])
 def test_node_to_vertex_force_and_tangent_match_finite_differences(multiplier):
     from dolfinx_corot.contact.kernels2d import node_to_vertex
@@ -100,19 +115,7 @@ def test_node_to_vertex_force_and_tangent_match_finite_differences(multiplier):
 
         g, p, f, K = ev(x0, True)
         assert g[0] < 0 and p[0] > 0
-        h = 1e-7
-        fd_K = np.zeros((4, 4))
-        fd_f = np.zeros(4)
-        for j in range(4):
-            e = np.zeros(4)
-            e[j] = h
-            fd_K[:, j] = (ev(x0 + e)[2][0] - ev(x0 - e)[2][0]) / (2 * h)
-            # f = ∂Φ/∂x with Φ = A/(2ε) p²
-            Wp = area[0] / (2 * eps[0]) * ev(x0 + e)[1][0] ** 2
-            Wm = area[0] / (2 * eps[0]) * ev(x0 - e)[1][0] ** 2
-            fd_f[j] = (Wp - Wm) / (2 * h)
-        assert np.abs(f[0] - fd_f).max() < 1e-6 * np.abs(f[0]).max()
-        assert np.abs(K[0] - fd_K).max() < 1e-6 * np.abs(K[0]).max()
+        _check_vertex_pair_by_fd(ev, x0, f[0], K[0], area[0], eps[0])
 
 
 @pytest.mark.parametrize("multiplier", [0.0, 2.0])
@@ -137,18 +140,7 @@ def test_node_to_vertex_around_a_beam_kink_matches_finite_differences(multiplier
 
         g, p, f, K = ev(x0, True)
         assert abs(g[0] - (np.linalg.norm(d) - r)) < 1e-14 and p[0] > 0
-        h = 1e-7
-        fd_K = np.zeros((4, 4))
-        fd_f = np.zeros(4)
-        for j in range(4):
-            e = np.zeros(4)
-            e[j] = h
-            fd_K[:, j] = (ev(x0 + e)[2][0] - ev(x0 - e)[2][0]) / (2 * h)
-            Wp = area[0] / (2 * eps[0]) * ev(x0 + e)[1][0] ** 2
-            Wm = area[0] / (2 * eps[0]) * ev(x0 - e)[1][0] ** 2
-            fd_f[j] = (Wp - Wm) / (2 * h)
-        assert np.abs(f[0] - fd_f).max() < 1e-6 * np.abs(f[0]).max()
-        assert np.abs(K[0] - fd_K).max() < 1e-6 * np.abs(K[0]).max()
+        _check_vertex_pair_by_fd(ev, x0, f[0], K[0], area[0], eps[0])
 
 
 def test_node_to_vertex_continues_node_to_segment_at_the_segment_end():

@@ -547,6 +547,15 @@ def _wall_face_gap(wall, points: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
+def _assert_fill_stress_free(ground, pair) -> None:
+    """The fill's stresses are 1e-9 of the ground's and the wall–fill contact carries nothing."""
+    stress = _stresses(ground)
+    in_fill = (lambda p: p[0] > 2.1 and p[1] > 2.0)
+    ground_max = max(np.abs(v).max() for p, v in stress.items() if not in_fill(p))
+    assert max(np.abs(v).max() for p, v in stress.items() if in_fill(p)) < 1e-9 * ground_max
+    assert np.abs(pair.resultant(on="slaves")).max() < 1e-9 * Q_PLATE
+
+
 def test_mapping_of_new_fill_onto_the_deformed_configuration():
     """Seed §3.1.2, approach II: before the fill appears, its nodes are mapped by the E = 1, ν = 0
     sub-problem with the seed's boundary shifts. Asserted class by class: the slaves of the fill's
@@ -584,11 +593,7 @@ def test_mapping_of_new_fill_onto_the_deformed_configuration():
     moved = np.flatnonzero(mapping.moved)
     assert len(moved) and all(np.abs(U[tuple(np.round(mapping.X[r], 9))] - mapping.shift[r]).max() < 1e-12 * scale
                               for r in moved)
-    stress = _stresses(ground)
-    in_fill = (lambda p: p[0] > 2.1 and p[1] > 2.0)
-    ground_max = max(np.abs(v).max() for p, v in stress.items() if not in_fill(p))
-    assert max(np.abs(v).max() for p, v in stress.items() if in_fill(p)) < 1e-9 * ground_max
-    assert np.abs(pair.resultant(on="slaves")).max() < 1e-9 * Q_PLATE
+    _assert_fill_stress_free(ground, pair)
 
 
 def test_contact_appearing_in_approach_one_takes_its_initial_gap_as_zero():
@@ -603,11 +608,7 @@ def test_contact_appearing_in_approach_one_takes_its_initial_gap_as_zero():
     gaps = _wall_face_gap(wall, itf.slave.positions(comm)[slaves])  # (the fill does not move)
     assert np.abs(itf.initial_gap[slaves] - gaps).max() < 1e-9
     assert np.abs(gaps).max() > 0.01
-    stress = _stresses(ground)
-    in_fill = (lambda p: p[0] > 2.1 and p[1] > 2.0)
-    ground_max = max(np.abs(v).max() for p, v in stress.items() if not in_fill(p))
-    assert max(np.abs(v).max() for p, v in stress.items() if in_fill(p)) < 1e-9 * ground_max
-    assert np.abs(pair.resultant(on="slaves")).max() < 1e-9 * Q_PLATE
+    _assert_fill_stress_free(ground, pair)
 
 
 def test_mapping_refuses_new_cells_that_nothing_holds():

@@ -113,8 +113,12 @@ def test_demo_under_mpi_reproduces_serial_values(demo, serial_outputs, tmp_path)
     b = json.loads((tmp_path / demo / "tip_values.json").read_text())
     assert b["ranks"] == 2
     np.testing.assert_allclose(b["load_factor"], a["load_factor"], rtol=1e-8, atol=1e-8)
+    # Newton stops at ‖r‖ ≤ 1e-9 of the reference force, so two runs whose round-off differs may
+    # stop one iteration apart: each recorded series is compared to 1e-7 of its own largest value
+    # (a penalty contact force, ε·gap, magnifies the gap's round-off by the penalty)
     for key in set(a) - {"ranks", "load_factor"}:
-        np.testing.assert_allclose(b[key], a[key], rtol=0, atol=1e-8, err_msg=key)
+        scale = float(np.max(np.abs(np.asarray(a[key], dtype=float)), initial=0.0))
+        np.testing.assert_allclose(b[key], a[key], rtol=0, atol=1e-7 * scale + 1e-12, err_msg=key)
 
 
 @pytest.mark.mpi

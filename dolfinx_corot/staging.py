@@ -52,7 +52,8 @@ from mpi4py import MPI
 
 from .assembly import make_system
 from .result import Result
-from .solvers import ConvergenceError, LoadControl, solve
+from .solvers import CheckpointError, ConvergenceError, CriticalPoint, LoadControl, solve
+from .solvers.run import read_checkpoint
 
 APPROACHES = ("I", "II")
 
@@ -76,7 +77,7 @@ class Stage:
 
 
 def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: Sequence = (),
-                 on_step=None) -> list[Result]:
+                 on_step=None, checkpoint: str | None = None, restart: str | None = None) -> list[Result]:
     """Run ``stages`` in turn on ``scene``; ``initial`` = [(solid part, cell group), …] exist from
     the start (the rest of each staged solid does not, until a stage adds it). ``on_step(stage,
     row)`` is called after every converged step with the :class:`Stage` and the step's history
@@ -89,7 +90,15 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
     before plus the change of the parts' internal force at the current configuration u₀ that
     the change of existence makes — the force of removed cells (released as λ → 1) and nothing
     for cells activated strain-free. The stage thus starts in equilibrium (to the tolerance the
-    stage before ended with)."""
+    stage before ended with).
+
+    checkpoint: a file (``.npz``) rewritten after every converged step of every stage with what a
+    restart needs besides the configuration: the stage reached, each element's activation state
+    (s, m; U_os of the structures), U_e, the force the stage started from, the interfaces' initial
+    gaps and the results of the stages before. restart: such a file; the run goes on in the stage
+    and at the step it holds, with the same scene, approach and stages up to that one (later
+    stages may differ; the stage reached may be given another driver of its kind, e.g. smaller
+    steps after a failure, see the drivers' ``run``), and reproduces the uninterrupted run."""
     if approach not in APPROACHES:
         raise ValueError(f"solve_stages: approach = {approach!r} is not one of {APPROACHES}")
     staged = {}
@@ -109,10 +118,11 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
         staged[id(ref.model)][1][ref.model.tmesh.cells(group)] = True
     for model, exists in staged.values():
         model.set_existing(exists)
+    resume = None if restart is None else _StageFile.read(restart, scene.model.comm, approach, stages)
     memorized = {}  # approach II: U_e of each staged solid after the last excavation stage
     loads = fint = None  # where the last stage ended: F_{k-1} and f_int,k-1(u₀) (owned entries)
     results = []
-    for stage in stages:
+    for index, stage in enumerate(stages):
         before = {key: exists.copy() for key, (_, exists) in staged.items()}
         for ref, group in stage.add:
             staged[id(ref.model)][1][ref.model.tmesh.cells(group)] = True
@@ -122,6 +132,12 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
                 raise ValueError(f"solve_stages: stage '{stage.name}' removes '{group}' of {ref.kind} "
                                  f"'{ref.name}', which does not exist (entirely) at that stage")
             staged[id(ref.model)][1][cells] = False
+        resuming = resume is not None and index == resume.stage
+        if resume is not None and index < resume.stage:  # done before the checkpoint
+            for model, exists in staged.values():
+                model.set_existing(exists)
+            results.append(resume.results[index])
+            continue
         # structures first (approach II: they memorize U_os), then the continua — in approach II
         # new continuum is mapped onto the deformed configuration before it appears
         mappings, held_slaves = [], []
@@ -132,25 +148,35 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
             if model.continuum:
                 new = exists & ~before[key]
                 reference = None
-                if approach == "II" and model.comm.allreduce(bool(new.any()), op=MPI.LOR):
+                if approach == "II" and not resuming and model.comm.allreduce(bool(new.any()), op=MPI.LOR):
                     reference, mapping, held = _map_new_continuum(scene, model, exists, new, memorized.get(key))
                     mappings.append(mapping)
                     held_slaves += held
                 model.set_existing(exists, reference)
+        if resuming:  # each element's activation state as the checkpoint holds it (before the weights)
+            memorized, mappings = resume.enter([m for m, _ in staged.values()])
         system = make_system(scene.model, solver=scene.linear_solver, contributions=scene.contributions())
         try:
-            system.start_stage(approach)
-            for itf, slaves in held_slaves:  # slaves of new cells that cannot move onto their master
-                itf.cancel_initial_gaps(slaves)
-            start = system.evaluate_internal_force()
-            if loads is not None:
-                start += loads - fint
-            loads = system.ramp_loads_from(start)
+            if resuming:  # the stage's start as the checkpoint holds it (the configuration: solve's restart)
+                start = resume.start(system)
+                loads = system.ramp_loads_from(start)
+            else:
+                system.start_stage(approach)
+                for itf, slaves in held_slaves:  # slaves of new cells that cannot move onto their master
+                    itf.cancel_initial_gaps(slaves)
+                start = system.evaluate_internal_force()
+                if loads is not None:
+                    start += loads - fint
+                loads = system.ramp_loads_from(start)
             if stage.reset_displacements:
                 _check_resettable(system, staged, stage)
+            attach = ({}, None) if checkpoint is None else \
+                _StageFile.attach(system, [m for m, _ in staged.values()], approach, stages, index, results,
+                                  mappings, start, memorized)
             try:
                 step = None if on_step is None else (lambda row, stage=stage: on_step(stage, row))
-                result = solve(scene, stage.driver, system=system, on_step=step)
+                result = solve(scene, stage.driver, system=system, on_step=step, checkpoint=checkpoint,
+                               restart=restart if resuming else None, attach=attach)
             except ConvergenceError as err:
                 err.result.mappings = mappings
                 err.results = results + [err.result]
@@ -173,6 +199,126 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
         finally:
             system.destroy()
     return results
+
+
+class _StageFile:
+    """What a staged run writes into its checkpoints besides the configuration (``staging`` in the
+    file's meta, arrays ``staging_*``), and reads back at a restart."""
+
+    def __init__(self, stage: int, results: list, meta: dict, arrays: dict, path: str):
+        self.stage, self.results, self.meta, self.arrays, self.path = stage, results, meta, arrays, path
+
+    @staticmethod
+    def _mapping_arrays(prefix: str, mappings: list) -> dict:
+        out = {}
+        for q, mp in enumerate(mappings):
+            out.update({f"{prefix}mapping{q}_X": mp.X, f"{prefix}mapping{q}_shift": mp.shift,
+                        f"{prefix}mapping{q}_kind": np.asarray(mp.kind, dtype=str),
+                        f"{prefix}mapping{q}_moved": np.asarray(mp.moved, dtype=bool)})
+        return out
+
+    @staticmethod
+    def _mappings(arrays: dict, prefix: str, parts: list) -> list:
+        return [Mapping(part, arrays[f"{prefix}mapping{q}_X"], arrays[f"{prefix}mapping{q}_shift"],
+                        arrays[f"{prefix}mapping{q}_kind"].astype(str), arrays[f"{prefix}mapping{q}_moved"])
+                for q, part in enumerate(parts)]
+
+    @classmethod
+    def attach(cls, system, models: list, approach: str, stages, index: int, results: list, mappings: list,
+               start: np.ndarray, memorized: dict) -> tuple[dict, dict | None]:
+        """(meta, arrays on rank 0) of stage ``index`` (collective): they do not change within it."""
+        arrays = {}
+        vec = system.new_vector()
+        vec.array[:] = start
+        for key, value in system.global_arrays({"staging_start": vec}).items():
+            if key.startswith("staging_start"):
+                arrays[key] = value
+        vec.destroy()
+        for j, model in enumerate(models):
+            for key, value in model.staging_arrays().items():
+                arrays[f"staging_part{j}_{key}"] = value
+            if id(model) in memorized:
+                arrays[f"staging_part{j}_Ue"] = model.to_global(memorized[id(model)])
+        finished = []
+        for k, res in enumerate(results):
+            finished.append({"history": res.history.rows, "completed": res.completed, "message": res.message,
+                             "totals": res.totals, "profiles": list(res.profiles),
+                             "critical_points": [c.as_dict() for c in res.critical_points],
+                             "mappings": [mp.part for mp in getattr(res, "mappings", [])]})
+            for p, profile in enumerate(res.profiles.values()):
+                arrays.update(profile.arrays(f"staging_result{k}_profile{p}_"))
+            arrays.update(cls._mapping_arrays(f"staging_result{k}_", getattr(res, "mappings", [])))
+        arrays.update(cls._mapping_arrays("staging_current_", mappings))
+        meta = {"approach": approach, "stages": [st.name for st in stages], "stage": index, "finished": finished,
+                "mappings": [mp.part for mp in mappings]}
+        return meta, (arrays if system.comm.rank == 0 else None)
+
+    @classmethod
+    def read(cls, path: str, comm, approach: str, stages) -> "_StageFile":
+        """The staged part of a checkpoint, checked against this run's approach and stages."""
+        found = None
+        if comm.rank == 0:
+            try:
+                found = read_checkpoint(path)
+            except CheckpointError as err:
+                found = err
+        found = comm.bcast(found, root=0)
+        if isinstance(found, CheckpointError):
+            raise found
+        meta, arrays = found
+        st = meta.get("staging")
+        if st is None:
+            raise CheckpointError(f"the checkpoint {path} was written by a run without stages: restart it with solve")
+        if st["approach"] != approach:
+            raise CheckpointError(f"the checkpoint {path} was computed with approach {st['approach']}, this run asks "
+                                  f"for approach {approach}: a restart goes on with the same approach")
+        k = int(st["stage"])
+        names = [s.name for s in stages]
+        if len(names) <= k or names[: k + 1] != st["stages"][: k + 1]:
+            first = next((i for i in range(k + 1) if i >= len(names) or names[i] != st["stages"][i]), k)
+            now = repr(names[first]) if first < len(names) else "no stage"
+            raise CheckpointError(f"the checkpoint {path} is in stage {k + 1} '{st['stages'][k]}' of a run whose "
+                                  f"stage {first + 1} is '{st['stages'][first]}', this run has {now} there: a "
+                                  "restart goes on with the same stages up to the one it stopped in")
+        from .result import History, Profile
+        results = []
+        for j, done in enumerate(st["finished"]):
+            history = History()
+            for row in done["history"]:
+                history.append(row)
+            profiles = {name: Profile.from_arrays(arrays, f"staging_result{j}_profile{p}_")
+                        for p, name in enumerate(done["profiles"])}
+            points = [CriticalPoint(**{**c, "bracket": tuple(c["bracket"])}) for c in done["critical_points"]]
+            res = Result(history, done["completed"], done["message"], done["totals"], profiles, points)
+            res.mappings = cls._mappings(arrays, f"staging_result{j}_", done["mappings"])
+            results.append(res)
+        return cls(k, results, st, arrays, path)
+
+    def enter(self, models: list) -> tuple[dict, list]:
+        """Restore the staged parts' element state; returns (U_e per staged solid, the stage's
+        mappings)."""
+        memorized = {}
+        for j, model in enumerate(models):
+            prefix = f"staging_part{j}_"
+            mine = {k[len(prefix):]: v for k, v in self.arrays.items() if k.startswith(prefix)}
+            try:
+                model.set_staging_arrays(mine)
+                if "Ue" in mine:
+                    memorized[id(model)] = model.from_global(mine["Ue"]).reshape(-1, model.gdim)
+            except ValueError as err:
+                raise CheckpointError(f"the checkpoint {self.path} was written for another scene: {err}") from None
+        return memorized, self._mappings(self.arrays, "staging_current_", self.meta["mappings"])
+
+    def start(self, system) -> np.ndarray:
+        """The force the stage started from (owned entries of ``system``)."""
+        vec = system.new_vector()
+        try:
+            system.global_to_vector(self.arrays, "staging_start", vec)
+        except (KeyError, ValueError) as err:
+            raise CheckpointError(f"the checkpoint {self.path} was written for another scene: {err}") from None
+        start = vec.array.copy()
+        vec.destroy()
+        return start
 
 
 @dataclass

@@ -644,3 +644,123 @@ def test_mapping_refuses_new_cells_that_nothing_holds():
     sc.fix(soil, "base")
     with pytest.raises(ValueError, match="mapping of new continuum .approach II.: the cells added are not held"):
         solve_stages(sc, [Stage("block", add=[(soil, "block")])], approach="II", initial=[(soil, "ground")])
+
+
+# -- checkpoint and restart of a staged run ------------------------------------------------------
+class Killed(Exception):
+    """Raised from on_step: the run dies after a step (its checkpoint holds the step before)."""
+
+
+def _box_in_pit_scene(approach_slaves_on_fill: bool = True):
+    """A coarse box frame in a pit, filled in two layers (the frame-filling demos' scene): geostatic
+    stage (reset), excavation (U_e), frame (U_os), two fill layers with frame–fill contact."""
+    from dolfinx_corot.io.gmsh_models import box_in_pit
+    tm, lines = box_in_pit(12.0, 8.0, 8.0, 4.0, 4.0, 2.0, 0.2, 1, 1, 1.0)
+    sc = dc.Scene(large_rotations=True, linear_solver="direct")
+    soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(50e6, 0.3, density=2000.0), degree=1)
+    fill = sc.add_solid(tm, "fill", material=dc.SaintVenantKirchhoff(10e6, 0.3, density=1800.0), degree=1)
+    concrete = dc.Elastic(30e9, 0.2, density=2500.0)
+    frame = sc.add_beam(lines, "frame", section=dc.Rectangle(1.0, 0.2), material=concrete, plane_strain=True)
+    slab = sc.add_beam(lines, "slab", section=dc.Rectangle(1.0, 0.2), material=concrete, plane_strain=True)
+    sc.fix(soil, "base")
+    sc.fix(soil, "sides", dofs=("ux",))
+    sc.fix(soil, "symmetry", dofs=("ux",))
+    sc.fix(frame, "roof_centre", dofs=("rz",))
+    sc.fix(slab, "slab_centre", dofs=("rz",))
+    for part in (soil, frame, slab):
+        sc.gravity(part, (0.0, -10.0))
+    pair = sc.contact((fill, "fill_face"), (frame, "frame"))
+    sc.monitor_reaction("base", soil, "base")
+    sc.monitor("floor", soil, "pit_floor", reduce="profile", along="x")
+    stages = [Stage("geostatic", reset_displacements=True),
+              Stage("excavation", remove=[(soil, "core"), (fill, "fill")], driver=dc.LoadControl(steps=2)),
+              Stage("frame", add=[(frame, "frame"), (slab, "slab")]),
+              Stage("layer 1", add=[(fill, "layer_1")], driver=dc.LoadControl(steps=3)),
+              Stage("layer 2", add=[(fill, "layer_2")], driver=dc.LoadControl(steps=2))]
+    initial = [(soil, "ground"), (soil, "core"), (fill, "fill")]
+    return sc, stages, initial, pair
+
+
+def _staged_state(sc) -> np.ndarray | None:
+    """Every part's configuration in input order (rank 0; None elsewhere)."""
+    found = [m.to_global(m.state.x.array) for m in sc.model.models]
+    return np.concatenate([f.ravel() for f in found]) if comm.rank == 0 else None
+
+
+@pytest.mark.parametrize("approach", ["I", "II"])
+@pytest.mark.parametrize("kill", [("layer 1", 2), ("layer 1", 1)])
+def test_a_staged_run_killed_and_restarted_reproduces_the_uninterrupted_one(tmp_path, approach, kill):
+    """Killed in the middle of a fill stage (the file holds its first step), or at the first step
+    of one (the file holds the last step of the frame stage): the restart goes on from there, with
+    the mapped references, the structures' U_os, U_e, the interface's initial gaps and the
+    stage's starting force as the file holds them, and reproduces the uninterrupted run step by
+    step, stage by stage (results of the stages before come from the file)."""
+    sc, stages, initial, _ = _box_in_pit_scene()
+    full = solve_stages(sc, stages, approach=approach, initial=initial)
+    path = comm.bcast(str(tmp_path / "staged.npz") if comm.rank == 0 else None, root=0)
+
+    def die(stage, row):
+        if (stage.name, row["step"]) == kill:
+            raise Killed
+
+    sc2, stages2, initial2, _ = _box_in_pit_scene()
+    with pytest.raises(Killed):
+        solve_stages(sc2, stages2, approach=approach, initial=initial2, on_step=die, checkpoint=path)
+    sc3, stages3, initial3, pair3 = _box_in_pit_scene()
+    resumed_steps = []
+    resumed = solve_stages(sc3, stages3, approach=approach, initial=initial3, checkpoint=path, restart=path,
+                           on_step=lambda stage, row: resumed_steps.append((stage.name, row["step"])))
+    assert resumed_steps[0] == (kill if kill[1] > 1 else ("layer 1", 1))
+    assert [len(r.history) for r in resumed] == [len(r.history) for r in full] == [1, 2, 1, 3, 2]
+    for a, b in zip(full, resumed):
+        np.testing.assert_array_equal(b.history.column("iterations"), a.history.column("iterations"))
+        np.testing.assert_allclose(b.history.column("base_Fy"), a.history.column("base_Fy"), rtol=1e-9)
+        np.testing.assert_allclose(b.profiles["floor"].values, a.profiles["floor"].values, rtol=1e-9,
+                                   atol=1e-12)
+        assert [m.part for m in b.mappings] == [m.part for m in a.mappings]
+        for ma, mb in zip(a.mappings, b.mappings):
+            np.testing.assert_array_equal(mb.kind, ma.kind)
+            np.testing.assert_allclose(mb.shift, ma.shift, rtol=0, atol=1e-14)
+    # the fill presses on the frame (the interface's state came through the file)
+    assert np.abs(pair3.resultant(on="slaves")).max() > 1e3
+    a, b = _staged_state(sc), _staged_state(sc3)
+    if comm.rank == 0:
+        assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()
+
+
+def test_a_staged_restart_refuses_another_approach_other_stages_or_a_plain_solve(tmp_path):
+    sc, stages, initial, _ = _box_in_pit_scene()
+    path = comm.bcast(str(tmp_path / "staged.npz") if comm.rank == 0 else None, root=0)
+
+    def die(stage, row):
+        if stage.name == "frame":
+            raise Killed
+
+    with pytest.raises(Killed):
+        solve_stages(sc, stages, approach="II", initial=initial, on_step=die, checkpoint=path)
+    sc, stages, initial, _ = _box_in_pit_scene()
+    with pytest.raises(dc.CheckpointError, match="approach II, this run asks for approach I"):
+        solve_stages(sc, stages, approach="I", initial=initial, restart=path)
+    renamed = [Stage("gravity", reset_displacements=True)] + stages[1:]
+    with pytest.raises(dc.CheckpointError, match="stage 1 is 'geostatic', this run has 'gravity' there"):
+        solve_stages(sc, renamed, approach="II", initial=initial, restart=path)
+    with pytest.raises(dc.CheckpointError, match="written by a staged run: restart it with solve_stages"):
+        dc.solve(sc, dc.LoadControl(steps=1), restart=path)
+
+
+def test_a_system_vector_goes_through_a_checkpoint_file_unchanged():
+    """Partition-independent arrays of a vector of the coupled solid + beams system and back: equal
+    on every rank (under MPI a beam's rotation at a node the solid owns elsewhere comes from the
+    rank that holds the beam)."""
+    sc, _, _, _ = _box_in_pit_scene()
+    system = make_system(sc.model, solver="direct", contributions=sc.contributions())
+    try:
+        v, w = system.new_vector(), system.new_vector()
+        v.array[:] = np.random.default_rng(comm.rank).random(len(v.array))
+        arrays = comm.bcast(system.global_arrays({"v": v}), root=0)
+        system.global_to_vector(arrays, "v", w)
+        assert np.array_equal(w.array, v.array)
+        # the solid's translations and the beams' translations and rotation
+        assert sorted(a.shape[1] for k, a in arrays.items() if k.startswith("v")) == [2, 3]
+    finally:
+        system.destroy()

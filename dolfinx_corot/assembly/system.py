@@ -890,6 +890,10 @@ class CoupledSystem(System):
         with vec.localForm() as f:
             for i, (m, loc) in enumerate(zip(self.model.models, self.layout.local)):
                 f.array[loc] = m.from_global(arrays[f"{name}{i}"])
+        # a dof this rank owns may be held by no model's nodes here (a beam's rotation at a node
+        # owned through the solid): its value comes from the rank whose model holds it (a ghost)
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.REVERSE)
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
     def destroy(self) -> None:
         super().destroy()

@@ -451,9 +451,17 @@ class Part:
         ids[self.V.dofmap.list.array] = geo[mesh.geometry.dofmap.array]
         return ids
 
+    def _key_ranks(self) -> np.ndarray:
+        """Rank of every local block's (owned and ghost) node key among the keys of all the
+        mesh's nodes: a partition-independent numbering 0…n−1 (a mesh of lines read from a gmsh
+        model holds only some of its nodes, whose input numbers have gaps)."""
+        keys = self.node_keys()
+        owned = keys[: self.V.dofmap.index_map.size_local]
+        return np.searchsorted(np.unique(np.concatenate(self.comm.allgather(owned))), keys)
+
     def _global_index(self) -> np.ndarray:
         """Position of each owned block in the partition-independent order of checkpoint files."""
-        return self.node_keys()[: self.V.dofmap.index_map.size_local]
+        return self._key_ranks()[: self.V.dofmap.index_map.size_local]
 
     def to_global(self, local: np.ndarray) -> np.ndarray | None:
         """Gather a local nodal array (blocks, k) to rank 0, in the order of :meth:`_global_index`."""
@@ -474,7 +482,52 @@ class Part:
         if values.shape[0] != self.V.dofmap.index_map.size_global:
             raise ValueError(f"the checkpoint holds {values.shape[0]} nodes; this model has "
                              f"{self.V.dofmap.index_map.size_global}: it was written for another mesh")
-        return values[self.node_keys()].ravel()
+        return values[self._key_ranks()].ravel()
+
+    # -- staged state in checkpoint files --------------------------------------------------
+    def staging_arrays(self) -> dict:
+        """The state staged construction keeps per element (activation shifts, references) as
+        partition-independent arrays on rank 0 (None elsewhere); {} for parts without it.
+        Existence itself is rebuilt from the stages at a restart."""
+        return {}
+
+    def set_staging_arrays(self, arrays: dict) -> None:
+        """Restore :meth:`staging_arrays`' output (every rank holds the arrays)."""
+
+    def _cells_to_global(self, blocks: np.ndarray, values: np.ndarray) -> dict | None:
+        """Per-cell nodal values in a partition-independent order, on rank 0: ``blocks`` (local
+        cells, n) the local blocks of each cell's nodes, ``values`` (local cells, n, k). Cells are
+        ordered by their input index, the nodes of each cell by their input number."""
+        n_owned = self.V.mesh.topology.index_map(self.tdim).size_local
+        cells = np.asarray(self.V.mesh.topology.original_cell_index, dtype=np.int64)[:n_owned]
+        keys = self.node_keys()[blocks[:n_owned]]
+        order = np.argsort(keys, axis=1)
+        keys = np.take_along_axis(keys, order, axis=1)
+        values = np.take_along_axis(np.asarray(values)[:n_owned], order[:, :, None], axis=1)
+        found = self.comm.gather((cells, keys, values), root=0)
+        if self.comm.rank != 0:
+            return None
+        cells, keys, values = (np.concatenate(a) for a in zip(*found))
+        first = np.argsort(cells)
+        return {"cells": cells[first], "nodes": keys[first], "values": values[first]}
+
+    def _cells_from_global(self, blocks: np.ndarray, saved: dict, label: str) -> np.ndarray:
+        """The per-cell nodal values of :meth:`_cells_to_global` for the local cells (owned and
+        ghost) whose nodes are ``blocks``, (local cells, n, k); a file of another mesh is refused."""
+        cells = np.asarray(self.V.mesh.topology.original_cell_index, dtype=np.int64)[: len(blocks)]
+        pos = np.searchsorted(saved["cells"], cells)
+        keys = self.node_keys()[blocks]
+        order = np.argsort(keys, axis=1)
+        ok = len(saved["cells"]) == self.V.mesh.topology.index_map(self.tdim).size_global and \
+            np.all(pos < len(saved["cells"]))
+        if ok:
+            ok = np.array_equal(saved["cells"][pos], cells) and \
+                np.array_equal(saved["nodes"][pos], np.take_along_axis(keys, order, axis=1))
+        if not self.comm.allreduce(bool(ok), op=MPI.LAND):
+            raise ValueError(f"{label}: the checkpoint's cells are not those of this mesh")
+        out = np.empty((len(blocks),) + saved["values"].shape[1:])
+        np.put_along_axis(out, order[:, :, None], saved["values"][pos], axis=1)
+        return out
 
     # -- description ------------------------------------------------------------------
     def _geometry_hash(self) -> str:

@@ -333,6 +333,24 @@ class Frame2D(AdditiveState, LineFrame):
         self._existing = np.asarray(exists, dtype=bool).copy()
         self._forms = None
 
+    def staging_arrays(self) -> dict:
+        """The state U_os of every element's nodes when it appeared (staged beams and bars)."""
+        if self.activation is None:
+            return {}
+        act = self.activation.x.array.reshape(-1, 2, self.ndof)[self.activation.function_space.dofmap.list.array]
+        found = self._cells_to_global(self.V.dofmap.list.array.reshape(-1, 2), act)
+        return {} if found is None else {f"cell_{k}": v for k, v in found.items()}
+
+    def set_staging_arrays(self, arrays: dict) -> None:
+        if self.activation is None:
+            return
+        saved = {k[len("cell_"):]: v for k, v in arrays.items() if k.startswith("cell_")}
+        values = self._cells_from_global(self.V.dofmap.list.array.reshape(-1, 2), saved,
+                                         f"staged beams '{self.parts[0].name if self.parts else ''}'")
+        act = self.activation.x.array.reshape(-1, 2, self.ndof)
+        act[self.activation.function_space.dofmap.list.array] = values
+        self._forms = None
+
     def held_blocks(self) -> np.ndarray:
         """Nodes that no (existing) element of the part touches — also without stages: a mesh of
         lines read from a model with solids holds the solids' nodes too."""

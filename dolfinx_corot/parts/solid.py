@@ -303,6 +303,29 @@ class Solid(AdditiveState, Part):
             self.activation_reference.x.array.reshape(-1, self.gdim)[dg] = ref[cg]
         self.existing.x.array[self._cell_dof] = exists.astype(float)
 
+    def staging_arrays(self) -> dict:
+        """Activation shift s and reference shift m of every cell's nodes (staged solids)."""
+        if self.existing is None:
+            return {}
+        n = self.nodes_per_cell
+        dg = self.activation_shift.function_space.dofmap.list.array.reshape(-1, n)
+        cg = self.V.dofmap.list.array.reshape(-1, n)
+        values = np.concatenate([f.x.array.reshape(-1, self.gdim)[dg]
+                                 for f in (self.activation_shift, self.activation_reference)], axis=2)
+        found = self._cells_to_global(cg, values)
+        return {} if found is None else {f"cell_{k}": v for k, v in found.items()}
+
+    def set_staging_arrays(self, arrays: dict) -> None:
+        if self.existing is None:
+            return
+        n, gdim = self.nodes_per_cell, self.gdim
+        dg = self.activation_shift.function_space.dofmap.list.array.reshape(-1, n)
+        cg = self.V.dofmap.list.array.reshape(-1, n)
+        saved = {k[len("cell_"):]: v for k, v in arrays.items() if k.startswith("cell_")}
+        values = self._cells_from_global(cg, saved, f"staged solid '{self.parts[0].name if self.parts else ''}'")
+        self.activation_shift.x.array.reshape(-1, gdim)[dg] = values[:, :, :gdim]
+        self.activation_reference.x.array.reshape(-1, gdim)[dg] = values[:, :, gdim:]
+
     def map_new_cells(self, new: np.ndarray, values: np.ndarray, imposed: np.ndarray) -> np.ndarray:
         """The seed's mapping of new continuum onto the deformed configuration (§3.1.2, approach
         II): the shift w of the nodes of the local cells ``new`` solving linear elasticity with

@@ -82,8 +82,12 @@ def read_checkpoint(path: str) -> tuple[dict, dict]:
 class Run:
     """Bookkeeping shared by the drivers: history rows, totals, failure, checkpoints."""
 
-    def __init__(self, scene, system: System, on_step, checkpoint: str | None = None):
+    def __init__(self, scene, system: System, on_step, checkpoint: str | None = None, attach=None):
         self.scene = scene
+        # (meta, arrays) written with every checkpoint by the run that holds this one (a staged
+        # run: the stage and what the stages before it left; ({}, None) without a checkpoint);
+        # arrays on rank 0
+        self.attach = attach
         self.system = system
         self.on_step = on_step
         self.checkpoint_path = checkpoint
@@ -157,6 +161,9 @@ class Run:
                     "load_factor": self.load_factor, "cuts": self.cuts, "iterations": self.iterations,
                     "history": self.history.rows, "driver": driver_state, "profiles": list(self.profiles),
                     "critical_points": [c.as_dict() for c in self.critical_points]}
+            if self.attach is not None:
+                meta["staging"] = self.attach[0]
+                arrays.update(self.attach[1] or {})
             for i, profile in enumerate(self.profiles.values()):
                 arrays.update(profile.arrays(f"profile{i}_"))
             tmp = self.checkpoint_path + ".tmp"
@@ -187,6 +194,9 @@ class Run:
             where = _first_difference(meta["scene"], json.loads(json.dumps(self._description, default=str)))
             raise CheckpointError(f"the checkpoint {path} was written for another scene: {where}. A restart "
                                   "continues the same scene (same meshes, parts, materials and interfaces)")
+        if ("staging" in meta) != (self.attach is not None):
+            raise CheckpointError(f"the checkpoint {path} was written by a "
+                                  f"{'staged run: restart it with solve_stages' if 'staging' in meta else 'run without stages: restart it with solve'}")
         if meta["driver"].get("name") != driver_name:
             raise CheckpointError(f"the checkpoint {path} was written by {meta['driver'].get('name')}, "
                                   f"not {driver_name}")
@@ -256,7 +266,7 @@ class Run:
 
 
 def solve(scene, driver, system: System | None = None, on_step=None, checkpoint: str | None = None,
-          restart: str | None = None) -> Result:
+          restart: str | None = None, attach=None) -> Result:
     """Run ``driver`` (LoadControl or ArcLength) on ``scene``; returns a :class:`Result`.
 
     On a step that fails after all cuts, raises :class:`ConvergenceError`
@@ -270,14 +280,15 @@ def solve(scene, driver, system: System | None = None, on_step=None, checkpoint:
     continue from. The scene must be the same (checked by the fingerprint; switching
     ``large_rotations`` is refused too); the driver of the same kind may ask for more
     (a larger ``final`` or ``max_steps``): see each driver's ``run``. A restarted run
-    reproduces the uninterrupted one.
+    reproduces the uninterrupted one. attach: (meta, arrays on rank 0) written into every
+    checkpoint besides (:func:`dolfinx_corot.staging.solve_stages` keeps its stage there).
     """
     own_system = system is None
     if own_system:
         system = make_system(scene.model, solver=scene.linear_solver,
                              contributions=scene.contributions())
     try:
-        return driver.run(Run(scene, system, on_step, checkpoint), restart)
+        return driver.run(Run(scene, system, on_step, checkpoint, attach), restart)
     finally:
         if own_system:
             system.destroy()

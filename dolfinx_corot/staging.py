@@ -379,6 +379,22 @@ def _map_new_continuum(scene, model, exists: np.ndarray, new: np.ndarray, memori
             values[block] = target[at[int(pos)]] - surf.X[pos]
             imposed[block] = True
             slave[block] = True
+    # seed §3.1.2: the mapping puts new nodes along an interface onto their master, so they must be
+    # slaves; a new face that is only a master has nothing to tell where it lies
+    for itf in scene.interfaces:
+        if itf.master_spec[0].model is not model:
+            continue
+        surf = itf.master
+        masters = surf.blocks[new_only[surf.blocks] & ~slave[surf.blocks]]
+        count = model.comm.allreduce(len(masters), op=MPI.SUM)
+        if count:
+            where = np.concatenate(model.comm.allgather(surf.X[surf.local[np.isin(surf.blocks, masters)]]))
+            raise ValueError(
+                f"mapping of new continuum (approach II): {count} node(s) of the new cells along contact "
+                f"'{itf.name}' (the first at {where[0].tolist()}) are masters there and slaves of no interface. "
+                "Approach II maps new continuum onto the deformed configuration by projecting its nodes along "
+                "a contact interface on their master, so they must be slave nodes (seed §3.1.2): put the slaves "
+                f"on '{itf.master_spec[1]}' and the masters on '{itf.slave_spec[1]}', or use approach I")
     free = new_only & outside & ~slave
     values[free, -1] = 0.0
     imposed[free, -1] = True

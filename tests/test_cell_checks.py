@@ -9,7 +9,7 @@ from mpi4py import MPI
 
 import dolfinx.mesh
 import dolfinx_corot as dc
-from dolfinx_corot.io.mesh import TaggedMesh, from_arrays, name_groups
+from dolfinx_corot.io.mesh import TaggedMesh, from_arrays, from_gmsh, name_groups
 
 comm = MPI.COMM_WORLD
 SQUARE = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
@@ -262,3 +262,28 @@ def test_clockwise_numbering_is_accepted_and_exact(cell, numbering):
     reaction = dc.solve(sc, dc.LoadControl(steps=1)).history.column("right_Fx")[-1]
     exact = E / (1 - nu**2) * delta / L * H
     assert abs(reaction - exact) < 1e-9 * exact, (reaction, exact)
+
+
+def test_a_boundary_group_off_the_mesh_is_named():
+    """A line group whose lines are not edges of the triangles (an anchor meshed beside the soil,
+    not embedded in it) cannot be a facet group of the soil's mesh: refused naming the group and
+    where its first such node lies, on every rank (DOLFINx would abort)."""
+    comm = MPI.COMM_WORLD
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("beside")
+        soil = gmsh.model.occ.addRectangle(0.0, 0.0, 0.0, 1.0, 1.0)
+        line = gmsh.model.occ.addLine(gmsh.model.occ.addPoint(2.0, 0.0, 0.0), gmsh.model.occ.addPoint(3.0, 0.0, 0.0))
+        gmsh.model.occ.synchronize()
+        gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, [soil]), "soil")
+        gmsh.model.setPhysicalName(1, gmsh.model.addPhysicalGroup(1, [line]), "anchor")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
+        gmsh.model.mesh.generate(2)
+    try:
+        with pytest.raises(ValueError, match=r"group 'anchor' \(dimension 1\): \d+ of its nodes belong to no cell of "
+                                             r"dimension 2 \(the first at \(2, 0, 0\)\)"):
+            from_gmsh(gmsh.model, 2, comm=comm)
+    finally:
+        if comm.rank == 0:
+            gmsh.finalize()

@@ -651,9 +651,10 @@ class Killed(Exception):
     """Raised from on_step: the run dies after a step (its checkpoint holds the step before)."""
 
 
-def _box_in_pit_scene(approach_slaves_on_fill: bool = True):
+def _box_in_pit_scene(slaves_on_fill: bool = True):
     """A coarse box frame in a pit, filled in two layers (the frame-filling demos' scene): geostatic
-    stage (reset), excavation (U_e), frame (U_os), two fill layers with frame–fill contact."""
+    stage (reset), excavation (U_e), frame (U_os), two fill layers with frame–fill contact (slaves
+    on the fill's face, or on the frame)."""
     from dolfinx_corot.io.gmsh_models import box_in_pit
     tm, lines = box_in_pit(12.0, 8.0, 8.0, 4.0, 4.0, 2.0, 0.2, 1, 1, 1.0)
     sc = dc.Scene(large_rotations=True, linear_solver="direct")
@@ -669,7 +670,8 @@ def _box_in_pit_scene(approach_slaves_on_fill: bool = True):
     sc.fix(slab, "slab_centre", dofs=("rz",))
     for part in (soil, frame, slab):
         sc.gravity(part, (0.0, -10.0))
-    pair = sc.contact((fill, "fill_face"), (frame, "frame"))
+    faces = [(fill, "fill_face"), (frame, "frame")]
+    pair = sc.contact(*(faces if slaves_on_fill else faces[::-1]))
     sc.monitor_reaction("base", soil, "base")
     sc.monitor("floor", soil, "pit_floor", reduce="profile", along="x")
     stages = [Stage("geostatic", reset_displacements=True),
@@ -764,3 +766,12 @@ def test_a_system_vector_goes_through_a_checkpoint_file_unchanged():
         assert sorted(a.shape[1] for k, a in arrays.items() if k.startswith("v")) == [2, 3]
     finally:
         system.destroy()
+
+
+def test_approach_two_refuses_new_fill_whose_face_is_only_a_master():
+    """Seed §3.1.2: with approach II the nodes of new continuum along an interface must be slaves
+    (the mapping projects them on their master); the fill's face as the master of the frame's
+    slaves is refused when the first layer comes, naming the interface and the reason."""
+    sc, stages, initial, _ = _box_in_pit_scene(slaves_on_fill=False)
+    with pytest.raises(ValueError, match=r"contact 'frame -> fill_face' .* must be slave nodes \(seed §3.1.2\)"):
+        solve_stages(sc, stages, approach="II", initial=initial)

@@ -267,6 +267,26 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
                 for entity in model.getEntitiesForPhysicalGroup(d, tag):
                     for enodes in model.mesh.getElements(d, entity)[2]:
                         in_mesh[np.asarray(enodes, dtype=np.int64)] = True
+        # the mesh's facet tags come from the groups of dimension tdim − 1 (when tdim is the highest):
+        # their elements must lie on the cells (DOLFINx cannot tag facets that are not the mesh's)
+        if not error and tdim == max(d for d, _ in phys):
+            for d, tag in phys:
+                if d != tdim - 1 or error:
+                    continue
+                for entity in model.getEntitiesForPhysicalGroup(d, tag):
+                    enodes = np.concatenate([np.asarray(n, dtype=np.int64)
+                                             for n in model.mesh.getElements(d, entity)[2]] or [np.zeros(0, int)])
+                    off = enodes[~in_mesh[enodes]]
+                    if len(off):
+                        at = model.mesh.getNode(int(off[0]))[0]
+                        kind = {1: "lines", 2: "faces"}.get(d, "elements")
+                        error = (f"physical group '{model.getPhysicalName(d, tag) or f'{d}:{tag}'}' (dimension {d}): "
+                                 f"{len(np.unique(off))} of its nodes belong to no cell of dimension {tdim} (the "
+                                 f"first at ({at[0]:.6g}, {at[1]:.6g}, {at[2]:.6g})): its {kind} are not on the "
+                                 f"mesh of dimension {tdim}, whose boundary groups they would be. Embed them in "
+                                 f"the cells before meshing (gmsh.model.mesh.embed({d}, tags, {tdim}, tag)), or "
+                                 "build a structure apart from the solid in a gmsh model of its own")
+                        break
         for d, tag in phys:
             name = model.getPhysicalName(d, tag) or f"{d}:{tag}"
             if name in groups:

@@ -1,6 +1,6 @@
 r"""Staged construction: a scene run as a sequence of stages, each with the elements that exist in it.
 
-A :class:`Stage` names the cell groups of solids and the groups of 2D beams and bars that appear
+A :class:`Stage` names the cell groups of solids and the groups of beams, bars and shell triangles that appear
 (``add``) or are excavated (``remove``) in it, on top of the stages before, and the driver that
 runs it (its own steps). :func:`solve_stages` runs the stages in turn on one configuration:
 
@@ -20,10 +20,11 @@ runs it (its own steps). :func:`solve_stages` runs the stages in turn on one con
   deformations): strains of u − s on the mesh, the original mesh being the reference. Approach
   II (large construction deformations): the reference of the new cell is the deformed position
   X + s, F = (I + ∇u)(I + ∇s)⁻¹. At small strain the two coincide.
-* **Structures** (2D beams and bars). Approach II: an element is added undeformed in the
-  configuration of that moment — the state of its nodes then (U_os, with the angles) is
-  memorized per element, its reference is X + U_os and its deformation U − U_os. Approach I:
-  the mesh is its reference and U its deformation.
+* **Structures** (beams and bars in 2D and 3D, shell triangles). Approach II: an element is added
+  undeformed in the configuration of that moment — the state of its nodes then (U_os, with the
+  rotations) is memorized per element, its reference is X + U_os and its deformation U − U_os
+  (in 3D the rotations since then, R R_osᵀ; a shell's frame and constants are those of X + U_os).
+  Approach I: the mesh is its reference and U its deformation.
 
 * **Mapping of new continuum** (approach II, seed §3.1.2). Before new cells appear, the shift w of
   their nodes solves linear elasticity with the seed's artificial constants E = 1, ν = 0 on the

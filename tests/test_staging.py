@@ -4,6 +4,7 @@ import gmsh
 import numpy as np
 import pytest
 from mpi4py import MPI
+from petsc4py import PETSc
 
 import dolfinx_corot as dc
 from dolfinx_corot.io.mesh import from_gmsh
@@ -145,20 +146,22 @@ def test_approach_one_at_large_strain_follows_the_uniaxial_law_layer_by_layer():
 
 
 def test_bad_stage_input_is_named():
-    """An unknown approach, a missing cell group and a part kind that cannot be staged yet (3D beams) each end
-    in a clear error before anything is solved."""
+    """An unknown approach, a missing cell group and a part kind that cannot be staged yet
+    (quadrilateral membranes) each end in a clear error before anything is solved."""
     sc, soil = _column_scene(2, large=False)
     with pytest.raises(ValueError, match=r"approach = 'III' is not one of \('I', 'II'\)"):
         solve_stages(sc, [Stage("one", add=[(soil, "layer1")])], approach="III")
     with pytest.raises(dc.GroupNotFoundError, match="'layer9' not found"):
         solve_stages(sc, [Stage("one", add=[(soil, "layer9")])])
-    from dolfinx_corot.io.gmsh_models import polyline
+    from dolfinx_corot.io.mesh import from_arrays
     sc2 = dc.Scene()
-    beam = sc2.add_beam(polyline([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], 2, line_name="beam", gdim=3), "beam",
-                        section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(1.0e3), orientation=(0.0, 0.0, 1.0))
-    with pytest.raises(NotImplementedError, match="solve_stages: beam 'beam': staged construction: Frame3D "
-                                                  "parts are not staged yet, only solids and 2D beams and bars"):
-        solve_stages(sc2, [Stage("one", add=[(beam, "beam")])])
+    quads = from_arrays(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]),
+                        np.array([[0, 1, 2, 3]]), cell_name="sheet", comm=comm)
+    sheet = sc2.add_membrane(quads, "sheet", thickness=0.01, material=dc.Elastic(1.0e3))
+    with pytest.raises(NotImplementedError, match="solve_stages: membrane 'sheet': staged construction: "
+                                                  "MembraneQuad parts are not staged yet, only solids, beams, "
+                                                  "bars and shell triangles"):
+        solve_stages(sc2, [Stage("one", add=[(sheet, "sheet")])])
 
 
 @pytest.mark.skipif(comm.size > 1, reason="dense finite differences of the assembled system: serial")
@@ -775,3 +778,190 @@ def test_approach_two_refuses_new_fill_whose_face_is_only_a_master():
     sc, stages, initial, _ = _box_in_pit_scene(slaves_on_fill=False)
     with pytest.raises(ValueError, match=r"contact 'frame -> fill_face' .* must be slave nodes \(seed §3.1.2\)"):
         solve_stages(sc, stages, approach="II", initial=initial)
+
+
+# -- 3D beams and shells in stages ---------------------------------------------------------------
+def _tangent_and_fd_by_updates(system, load_factor: float, h: float = 1e-6):
+    """(K, K_fd): the assembled tangent and −∂r/∂d by central differences of the state moved by
+    ±h along each dof through the model's update (translations add, spins turn R ← exp(h e) R)."""
+    cp = system.checkpoint()
+    system.residual(load_factor)
+    system.jacobian()
+    K = system.A.convert("dense").getDenseArray().copy()
+    n = K.shape[0]
+    Kfd = np.zeros((n, n))
+    for j in range(n):
+        r = []
+        for sign in (1, -1):
+            system.restore(cp)
+            system.dx.set(0.0)
+            system.dx.setValue(j, sign * h)
+            system.dx.assemble()
+            system.dx.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+            system.update()
+            system.residual(load_factor)
+            r.append(system.b.array.copy())
+        Kfd[:, j] = -(r[0] - r[1]) / (2 * h)
+    system.restore(cp)
+    return K, Kfd
+
+
+def _random_states(model, rng, translation: float, angle: float) -> None:
+    """Move every node's state by a random translation (up to ``translation``) and rotation (up to
+    ``angle``), rotations composed multiplicatively."""
+    from dolfinx_corot import rotations as rot
+    state = model.state.x.array.reshape(-1, 7)
+    for row in state:
+        row[:3] += rng.uniform(-translation, translation, 3)
+        row[3:] = rot.quat_mul(rot.quat_from_rotvec(rng.uniform(-angle, angle, 3)), row[3:].copy())
+
+
+def _memorize_current_states(model) -> None:
+    """Every cell's memorized states (approach II) = its nodes' current states."""
+    n = model.nodes_per_cell
+    blocks = model.V.dofmap.list.array.reshape(-1, n)
+    act = model.activation.x.array.reshape(-1, n, 7)
+    act[model.activation.function_space.dofmap.list.array] = model.state.x.array.reshape(-1, 7)[blocks]
+    model._forms = None  # (the shells' constants follow the memorized translations)
+
+
+def _staged_3d_scene(kind: str):
+    from dolfinx_corot.io.gmsh_models import polyline
+    from dolfinx_corot.io.mesh import from_arrays
+    sc = dc.Scene(large_rotations=True, linear_solver="direct")
+    if kind == "beam":
+        part = sc.add_beam(polyline([[0.0, 0.0, 0.0], [2.0, 0.5, 0.3]], 3, gdim=3), "beam",
+                           section=dc.Rectangle(0.2, 0.3), material=dc.Elastic(1.0e4), orientation=(0.0, 0.0, 1.0))
+        sc.fix(part, "base")
+        sc.load(part, "tip", force=(0.0, 0.0, -1.0))
+    else:
+        points = np.array([[x, y, 0.1 * x * y] for y in (0.0, 0.5, 1.0) for x in (0.0, 0.5, 1.0)])
+        cells = np.array([[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4], [3, 4, 7], [3, 7, 6], [4, 5, 8], [4, 8, 7]])
+        tm = from_arrays(points, cells, cell_name="shell", point_groups={"edge": np.array([0, 3, 6])}, comm=comm)
+        part = sc.add_shell(tm, "shell", thickness=0.05, material=dc.Elastic(2.0e4, 0.3))
+        sc.fix(part, "edge")
+    return sc, part
+
+
+@pytest.mark.skipif(comm.size > 1, reason="dense finite differences of the assembled system: serial")
+@pytest.mark.parametrize("kind", ["beam", "shell"])
+def test_staged_3d_tangent_matches_finite_differences(kind):
+    """3D beams and shell triangles added undeformed in a deformed configuration (approach II:
+    reference X + u_a, states since then (u − u_a, R R_aᵀ), a the memorized states): added at
+    random states (0.3 in translation, rotations up to 2 rad about any axis) they carry no
+    internal force (1e-12); moved on from there (0.1, 0.3 rad), their tangent against central
+    differences of the residual along translations and spins (R ← exp(h e) R), free dofs (1e-6)."""
+    sc, part = _staged_3d_scene(kind)
+    solve_stages(sc, [Stage("place", add=[(part, part.name)])], approach="II")
+    model = part.model
+    rng = np.random.default_rng(7)
+    _random_states(model, rng, 0.3, 2.0)  # a large rigid-looking motion and some strain
+    _memorize_current_states(model)
+    system = make_system(sc.model, solver="direct")
+    try:
+        # added undeformed there: no internal force, whatever the rotations (round-off)
+        system.residual(0.0)
+        system.jacobian()
+        scale = system.A.norm() * 0.3
+        assert np.abs(system.evaluate_internal_force()).max() < 1e-12 * scale
+        _random_states(model, rng, 0.1, 0.3)
+        K, Kfd = _tangent_and_fd_by_updates(system, 1.0)
+        fixed = np.concatenate([bc.dof_indices()[0] for bc in system.bcs])
+    finally:
+        system.destroy()
+    free = np.setdiff1d(np.arange(len(K)), fixed)
+    K, Kfd = K[np.ix_(free, free)], Kfd[np.ix_(free, free)]
+    assert np.abs(K).max() > 10.0
+    assert np.abs(K - Kfd).max() < 1e-6 * np.abs(K).max()
+
+
+L3, W3, H3 = 4.0, 1.0, 2.0  # 3D ground: length, width, height; the surcharge on x < L3/2
+
+
+def _ground_3d():
+    """A block of ground [0, L3] × [0, W3] × [0, H3] of tetrahedra in two halves along x, whose top
+    faces 'top_left' and 'top_right' carry a shell strip (the triangles of the same gmsh model)."""
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("ground3d")
+        occ = gmsh.model.occ
+        left, right = occ.addBox(0.0, 0.0, 0.0, L3 / 2, W3, H3), occ.addBox(L3 / 2, 0.0, 0.0, L3 / 2, W3, H3)
+        occ.fragment([(3, left)], [(3, right)])
+        occ.synchronize()
+        faces = {}
+        for _, tag in gmsh.model.getEntities(2):
+            x, y, z = occ.getCenterOfMass(2, tag)
+            name = ("base" if z < 1e-9 else ("top_left" if x < L3 / 2 else "top_right") if z > H3 - 1e-9 else
+                    "ends" if min(x, L3 - x) < 1e-9 else "sides_y" if min(y, W3 - y) < 1e-9 else None)
+            if name:
+                faces.setdefault(name, []).append(tag)
+        gmsh.model.setPhysicalName(3, gmsh.model.addPhysicalGroup(3, [v for _, v in gmsh.model.getEntities(3)]),
+                                   "ground")
+        for name, tags in faces.items():
+            gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, tags), name)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
+        gmsh.model.mesh.generate(3)
+    tm = from_gmsh(gmsh.model, 3, comm=comm)
+    surfaces = from_gmsh(gmsh.model, 3, comm=comm, dim=2)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm, surfaces
+
+
+def _ground_and_shell(large: bool):
+    tm, surfaces = _ground_3d()
+    sc = dc.Scene(large_rotations=large, linear_solver="direct")
+    soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU) if large else dc.Elastic(E, NU), degree=1)
+    sc.fix(soil, "base")
+    sc.fix(soil, "ends", dofs=("ux",))
+    sc.fix(soil, "sides_y", dofs=("uy",))
+    sc.load(soil, "top_left", traction=(0.0, 0.0, -Q_TOP))
+    sc.monitor("surface", soil, "top_left", reduce="min")
+    shells = [sc.add_shell(surfaces, group, thickness=0.3, material=dc.Elastic(E_BEAM, 0.2))
+              for group in ("top_left", "top_right")]
+    return sc, soil, shells
+
+
+def _shell_forces(shells) -> float:
+    """The largest nodal internal force of the shell strip (its model alone)."""
+    system = make_system(shells[0].model, solver="direct")
+    try:
+        return comm.allreduce(float(np.abs(system.evaluate_internal_force()).max(initial=0.0)), op=MPI.MAX)
+    finally:
+        system.destroy()
+
+
+def _nodal_3d(soil) -> dict:
+    m = soil.model
+    n = m.V.dofmap.index_map.size_local
+    return _by_position(m.V.tabulate_dof_coordinates()[:n], m.state.x.array.reshape(-1, 3)[:n])
+
+
+@pytest.mark.parametrize("approach", ["I", "II"])
+def test_a_shell_strip_added_on_settled_ground(approach):
+    """Seed §3.1.2 for shells. A surcharge settles half the top of a 3D block of ground into a
+    trough (1.3 % of the loaded length); then a shell strip appears on the whole top, sharing the
+    ground's nodes. Approach II (co-rotational, SVK ground): the strip is added undeformed in the
+    settled configuration — its nodal forces vanish (1e-9 of the surcharge's resultant) and the
+    ground does not move (1e-12). Approach I (geometrically linear): the mesh is the strip's
+    reference, so it takes the trough as its own deformation; the stage ends where one analysis
+    with the strip present from the start ends (1e-9), the strained strip acting on the ground."""
+    large = approach == "II"
+    sc, soil, shells = _ground_and_shell(large)
+    results = solve_stages(sc, [Stage("surcharge", driver=dc.LoadControl(steps=2)),
+                                Stage("shell", add=[(s, s.name) for s in shells])], approach=approach)
+    settled, after = (r.history.rows[-1]["surface_uz_min"] for r in results)
+    resultant = Q_TOP * L3 / 2 * W3
+    assert settled < -0.01 * L3 / 2
+    if approach == "II":
+        assert after == pytest.approx(settled, rel=1e-12)
+        assert _shell_forces(shells) < 1e-9 * resultant
+        return
+    direct, direct_soil, _ = _ground_and_shell(False)
+    dc.solve(direct, dc.LoadControl(steps=1))
+    staged, reference = _nodal_3d(soil), _nodal_3d(direct_soil)
+    scale = max(abs(v).max() for v in reference.values())
+    assert all(np.abs(staged[p] - u).max() < 1e-9 * scale for p, u in reference.items())
+    assert abs(after - settled) > 1e-3 * abs(settled)  # the strip bent into the trough acts on it
+    assert _shell_forces(shells) > 0.01 * resultant

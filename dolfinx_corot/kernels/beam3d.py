@@ -26,7 +26,7 @@ import numpy as np
 from ..corotation import frame3d
 from ..corotation.transform import force, stiffness
 from ..elements import beam3d as law
-from .spatial import H, last_node_columns, nodal_states, perturb, rotation_vector_dofs
+from .spatial import H, last_node_columns, nodal_states, perturb, rotation_vector_dofs, since_activation
 from .ufcx import tabulate_tensor_kernels
 
 NDOF = 12
@@ -146,3 +146,23 @@ def _tabulate(w, c, X, f, K, tangent):
 
 
 vector_kernel, matrix_kernel = tabulate_tensor_kernels(_tabulate, NDOF, NCOEF, 2)
+
+
+@numba.njit(cache=True, inline="always")
+def _tabulate_staged(w, c, X, f, K, tangent):
+    """An element added undeformed when its nodes' states were A = w[NCOEF:] (staged construction,
+    approach II): reference X + u_A, states since then (u − u_A, R R_Aᵀ)."""
+    Xa, Sa = since_activation(X, w[:2 * NSTATE].reshape(2, NSTATE),
+                              w[NCOEF:NCOEF + 2 * NSTATE].reshape(2, NSTATE))
+    _evaluate(Xa, Sa, w[2 * NSTATE:NCOEF], c[0] != 0.0, tangent, f, K)
+
+
+_staged = None
+
+
+def staged_kernels():
+    """(vector_kernel, matrix_kernel) of staged elements (compiled on first use)."""
+    global _staged
+    if _staged is None:
+        _staged = tabulate_tensor_kernels(_tabulate_staged, NDOF, NCOEF + 2 * NSTATE, 2)
+    return _staged

@@ -31,7 +31,7 @@ from ..corotation import frame_triangle as frame
 from ..corotation.transform import linear_force, stiffness
 from ..elements import shell_triangle as law
 from .spatial import (H, last_node_columns, nodal_states, pack_constants, perturb, rotation_vector_dofs,
-                      unpack_constants)
+                      since_activation, unpack_constants)
 from .ufcx import tabulate_tensor_kernels
 
 NDOF = 18
@@ -170,3 +170,28 @@ def _tabulate(w, c, X, f, K, tangent):
 
 
 vector_kernel, matrix_kernel = tabulate_tensor_kernels(_tabulate, NDOF, NCOEF, 3)
+
+
+@numba.njit(cache=True, inline="always")
+def _tabulate_staged(w, c, X, f, K, tangent):
+    """An element added undeformed when its nodes' states were A = w[NCOEF:] (staged construction,
+    approach II): reference X + u_A (its constants computed there), states since then
+    (u − u_A, R R_Aᵀ)."""
+    Xa, Sa = since_activation(X, w[:_P0].reshape(3, NSTATE), w[NCOEF:NCOEF + 3 * NSTATE].reshape(3, NSTATE))
+    props = w[_P0:_E0]
+    edata = w[_E0:NCOEF]
+    if c[0] == 0.0:
+        linear(Xa, Sa, props, edata, f, K)
+    else:
+        corotational_cached(Xa, Sa, props, edata, f, K, tangent)
+
+
+_staged = None
+
+
+def staged_kernels():
+    """(vector_kernel, matrix_kernel) of staged elements (compiled on first use)."""
+    global _staged
+    if _staged is None:
+        _staged = tabulate_tensor_kernels(_tabulate_staged, NDOF, NCOEF + 3 * NSTATE, 3)
+    return _staged

@@ -17,14 +17,17 @@ spins w (R_a ← exp(w_a) R_a).
   the nodal rotation multiplicatively, R_a ← exp(i h e_k) R_a, as Newton
   updates it;
 * :func:`last_node_columns`: the six columns of the last node, exactly, from
-  the others and f (translation and rotation invariance of f).
+  the others and f (translation and rotation invariance of f);
+* :func:`since_activation`: an element added undeformed when its nodes' states were A
+  (staged construction, approach II) sees the nodes at X + u_A and their states since then,
+  (u − u_A, R R_Aᵀ); the spins are unchanged (exp(w) R R_Aᵀ), so is the tangent.
 """
 from __future__ import annotations
 
 import numba
 import numpy as np
 
-from ..rotations import exp_so3, log_so3, matmul3, quat_to_matrix
+from ..rotations import exp_so3, log_so3, matmul3, quat_mul, quat_to_matrix
 
 H = 1e-30  # complex step
 
@@ -118,3 +121,21 @@ def last_node_columns(f, X, u, K):
                 e0, e1, e2 = _cross_e(k, r[a, 0], r[a, 1], r[a, 2])
                 acc -= K[i, 6 * a] * e0 + K[i, 6 * a + 1] * e1 + K[i, 6 * a + 2] * e2
             K[i, last + 3 + k] = acc
+
+
+@numba.njit(cache=True)
+def since_activation(X, S, A):
+    """(X + u_A, S since A) for nodes X (n, 3), states S (n, 7) and states at activation A (n, 7):
+    displacements u − u_A, quaternions q∘q_A⁻¹ (R R_Aᵀ)."""
+    Xa = np.empty((X.shape[0], 3))
+    Sa = np.empty((S.shape[0], 7))
+    qi = np.empty(4)
+    for a in range(S.shape[0]):
+        for k in range(3):
+            Xa[a, k] = X[a, k] + A[a, k]
+            Sa[a, k] = S[a, k] - A[a, k]
+        qi[0] = A[a, 3]
+        for k in range(1, 4):
+            qi[k] = -A[a, 3 + k]
+        Sa[a, 3:7] = quat_mul(S[a, 3:7].copy(), qi)
+    return Xa, Sa

@@ -188,7 +188,7 @@ class Part:
         """Take part in staged construction (:mod:`dolfinx_corot.staging`): existence per element
         from now on. Parts that cannot be staged yet say so."""
         raise NotImplementedError(f"staged construction: {type(self).__name__} parts are not staged yet, only "
-                                  "solids and 2D beams and bars")
+                                  "solids, beams, bars and shell triangles")
 
     def is_staged(self) -> bool:
         """Whether the part has existence per element (staged construction)."""
@@ -246,6 +246,10 @@ class Part:
         if not self.can_reset_displacements():
             raise NotImplementedError(f"{type(self).__name__} parts cannot discard their displacements and keep "
                                       "their strains")
+        self._reset_state()
+
+    def _reset_state(self) -> None:
+        """Displacements zero (and rotations the identity, where the state holds them)."""
         self.state.x.array[:] = 0.0
 
     def _fixed_blocks(self) -> np.ndarray:

@@ -131,10 +131,6 @@ class LineFrame(Part):
         self._forms = None
         Part.capture_reference(self)
 
-    def _reset_state(self) -> None:
-        """Displacements zero, rotations the identity."""
-        self.state.x.array[:] = 0.0
-
     def add_truss(self, where, area, material, prestress_force) -> PartRef:
         return self.add_bars(where, material.E * area, float(prestress_force))
 
@@ -219,24 +215,103 @@ class LineFrame(Part):
         return self._forms
 
     def _element_constants(self) -> list:
-        """Extra per-cell coefficients the kernels read after the properties (none by default)."""
+        """Per-cell coefficients the kernels read after the properties: the kernels' own
+        (:meth:`_kernel_constants`), then the nodes' states at activation of staged elements
+        (approach II)."""
+        return self._kernel_constants() + ([self.activation] if self._staged_shift() else [])
+
+    def _kernel_constants(self) -> list:
+        """Per-cell constants of the kernels (none by default)."""
         return []
 
     def _kernel_pair(self):
-        """(vector kernel, matrix kernel) of the elements."""
+        """(vector kernel, matrix kernel) of the elements (approach II: of elements added undeformed)."""
+        if self._staged_shift():
+            return self.kernels.staged_kernels()
         return self.kernels.vector_kernel, self.kernels.matrix_kernel
 
-    _existing: np.ndarray | None = None  # staged construction: which local cells exist (None: all)
+    # -- staged construction (dolfinx_corot.staging) ---------------------------------
+    _existing: np.ndarray | None = None  # which local cells exist (None: all)
+    activation: dolfinx.fem.Function | None = None  # approach II: the nodes' states when each cell appeared
+
+    def start_staging(self, approach: str) -> None:
+        """Existence per element from now on (none until :meth:`set_existing`). Approach II
+        (seed §3.1.2): an element appears undeformed in the configuration of that moment — the
+        state of its nodes then, U_os (with their rotations), is memorized per element and its
+        deformation is U − U_os (rotations R R_osᵀ), its reference the positions X + U_os.
+        Approach I: the mesh is the reference and U the deformation (fit for small construction
+        deformations, or nodes at rest until then)."""
+        if not hasattr(self.kernels, "staged_kernels"):
+            raise NotImplementedError(f"staged construction: {type(self).__name__} parts are not staged yet, only "
+                                      "solids, beams, bars and shell triangles")
+        if self._existing is None:
+            self._existing = np.zeros(len(self._owner_of_cell), dtype=bool)
+            Q = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("DG", 0),
+                                                dim=self.nodes_per_cell * self.state_size)
+            self.activation = dolfinx.fem.Function(Q, name="activation")
+        self.approach = approach
+        self._forms = None
+
+    def is_staged(self) -> bool:
+        return self._existing is not None
+
+    def cells_existing(self) -> np.ndarray:
+        """(local cells, owned and ghost) whether each exists."""
+        return self._existing.copy()
+
+    def _activation_values(self) -> np.ndarray:
+        """(local cells, nodes, state_size) view of the memorized states, cell by cell."""
+        return self.activation.x.array.reshape(-1, self.nodes_per_cell, self.state_size)
+
+    def set_existing(self, exists: np.ndarray) -> None:
+        """Which local cells exist; with approach II the new ones memorize their nodes' state."""
+        new = exists & ~self._existing
+        if self.approach == "II" and new.any():
+            blocks = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)[new]
+            act = self._activation_values()
+            act[self.activation.function_space.dofmap.list.array[new]] = \
+                self.state.x.array.reshape(-1, self.state_size)[blocks]
+        self._existing = np.asarray(exists, dtype=bool).copy()
+        self._forms = None
+
+    def staging_arrays(self) -> dict:
+        """The state U_os of every element's nodes when it appeared (staged structures)."""
+        if self.activation is None:
+            return {}
+        act = self._activation_values()[self.activation.function_space.dofmap.list.array]
+        found = self._cells_to_global(self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell), act)
+        return {} if found is None else {f"cell_{k}": v for k, v in found.items()}
+
+    def set_staging_arrays(self, arrays: dict) -> None:
+        if self.activation is None:
+            return
+        saved = {k[len("cell_"):]: v for k, v in arrays.items() if k.startswith("cell_")}
+        values = self._cells_from_global(self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell), saved,
+                                         f"staged {self.kind_name} part '{self.parts[0].name if self.parts else ''}'")
+        self._activation_values()[self.activation.function_space.dofmap.list.array] = values
+        self._forms = None
+
+    def held_blocks(self) -> np.ndarray:
+        """Nodes that no (existing) element of the part touches — also without stages: a mesh of
+        lines read from a model with solids may hold nodes that no element of the part uses."""
+        return self._untouched_blocks(self._cells_active())
+
+    def _staged_shift(self) -> bool:
+        return self.activation is not None and self.approach == "II"
 
     def _cells_active(self) -> np.ndarray:
         """Local cells (owned and ghost) with elements that exist."""
         active = self._owner_of_cell != ""
         return active if self._existing is None else active & self._existing
 
+    def _activations(self, cells: np.ndarray) -> np.ndarray:
+        """(cells, nodes, state_size) state of the cells' nodes when they appeared (approach II)."""
+        return self._activation_values()[self.activation.function_space.dofmap.list.array[cells]]
+
     def _activation_translations(self, cells: np.ndarray) -> np.ndarray | float:
         """(cells, nodes, gdim) translation of the elements' reference from the mesh (elements
-        added undeformed in a deformed configuration); 0 by default."""
-        return 0.0
+        added undeformed in a deformed configuration, approach II); 0 otherwise."""
+        return self._activations(cells)[:, :, : self.gdim] if self._staged_shift() else 0.0
 
     def bending_blocks(self) -> np.ndarray:
         """Local blocks (owned and ghost) that a bending element on this rank touches."""
@@ -299,78 +374,6 @@ class Frame2D(AdditiveState, LineFrame):
     def _add(self, where, EA, EI, GAs, N0, kind):
         law2d.check_props(EA, EI, GAs, f"{kind} '{where}'")
         return self.add_elements(where, np.array([EA, EI, GAs, N0]), EI > 0.0, kind)
-
-    # -- staged construction (dolfinx_corot.staging) ---------------------------------
-    activation: dolfinx.fem.Function | None = None
-
-    def start_staging(self, approach: str) -> None:
-        """Existence per element from now on (none until :meth:`set_existing`). Approach II
-        (seed §3.1.2): an element appears undeformed in the configuration of that moment — the
-        state of its nodes then, U_os, is memorized per element and its deformation is U − U_os,
-        its reference the positions X + U_os. Approach I: the mesh is the reference and U the
-        deformation (fit for small construction deformations, or nodes at rest until then)."""
-        if self._existing is None:
-            self._existing = np.zeros(len(self._owner_of_cell), dtype=bool)
-            Q = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("DG", 0), dim=2 * self.ndof)
-            self.activation = dolfinx.fem.Function(Q, name="activation")
-        self.approach = approach
-        self._forms = None
-
-    def is_staged(self) -> bool:
-        return self._existing is not None
-
-    def cells_existing(self) -> np.ndarray:
-        """(local cells, owned and ghost) whether each exists."""
-        return self._existing.copy()
-
-    def set_existing(self, exists: np.ndarray) -> None:
-        """Which local cells exist; with approach II the new ones memorize their nodes' state."""
-        new = exists & ~self._existing
-        if self.approach == "II" and new.any():
-            blocks = self.V.dofmap.list.array.reshape(-1, 2)[new]
-            act = self.activation.x.array.reshape(-1, 2, self.ndof)
-            act[self.activation.function_space.dofmap.list.array[new]] = self.state.x.array.reshape(-1, self.ndof)[blocks]
-        self._existing = np.asarray(exists, dtype=bool).copy()
-        self._forms = None
-
-    def staging_arrays(self) -> dict:
-        """The state U_os of every element's nodes when it appeared (staged beams and bars)."""
-        if self.activation is None:
-            return {}
-        act = self.activation.x.array.reshape(-1, 2, self.ndof)[self.activation.function_space.dofmap.list.array]
-        found = self._cells_to_global(self.V.dofmap.list.array.reshape(-1, 2), act)
-        return {} if found is None else {f"cell_{k}": v for k, v in found.items()}
-
-    def set_staging_arrays(self, arrays: dict) -> None:
-        if self.activation is None:
-            return
-        saved = {k[len("cell_"):]: v for k, v in arrays.items() if k.startswith("cell_")}
-        values = self._cells_from_global(self.V.dofmap.list.array.reshape(-1, 2), saved,
-                                         f"staged beams '{self.parts[0].name if self.parts else ''}'")
-        act = self.activation.x.array.reshape(-1, 2, self.ndof)
-        act[self.activation.function_space.dofmap.list.array] = values
-        self._forms = None
-
-    def held_blocks(self) -> np.ndarray:
-        """Nodes that no (existing) element of the part touches — also without stages: a mesh of
-        lines read from a model with solids holds the solids' nodes too."""
-        return self._untouched_blocks(self._cells_active())
-
-    def _staged_shift(self) -> bool:
-        return self.activation is not None and self.approach == "II"
-
-    def _element_constants(self) -> list:
-        return [self.activation] if self._staged_shift() else []
-
-    def _kernel_pair(self):
-        return self.kernels.staged_kernels() if self._staged_shift() else super()._kernel_pair()
-
-    def _activations(self, cells: np.ndarray) -> np.ndarray:
-        """(cells, 2, ndof) state of the cells' nodes when they appeared (approach II)."""
-        return self.activation.x.array.reshape(-1, 2, self.ndof)[self.activation.function_space.dofmap.list.array[cells]]
-
-    def _activation_translations(self, cells: np.ndarray) -> np.ndarray | float:
-        return self._activations(cells)[:, :, : self.gdim] if self._staged_shift() else 0.0
 
     def element_forces(self) -> tuple[np.ndarray, np.ndarray]:
         """(cells, forces): the owned cells with existing elements and their end forces and

@@ -38,13 +38,15 @@ class Surface3D(Rotations3D, LineFrame):
         LineFrame.__init__(self, tmesh, large_rotations)
         self._init_state()
 
-    def _element_constants(self) -> list:
-        """The kernels' per-cell constants of every cell with elements (DG0, computed once)."""
+    def _kernel_constants(self) -> list:
+        """The kernels' per-cell constants of every cell with elements (DG0, computed once per
+        change of existence) from the cell's reference: the mesh, or where it appeared (approach II)."""
         mesh = self.tmesh.mesh
         n = self.kernels.NEDATA
         Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=n)
         edata = dolfinx.fem.Function(Q, name="element_constants")
         X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, self.nodes_per_cell)]
+        X = X + self._activation_translations(np.arange(len(X)))
         props = self.cell_properties(np.arange(len(X)))
         out = np.zeros((len(X), n))
         self.kernels.element_data_all(X, props, self._owner_of_cell != "", out)

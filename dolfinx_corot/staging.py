@@ -14,7 +14,9 @@ runs it (its own steps). :func:`solve_stages` runs the stages in turn on one con
   weight is applied over its stage; an excavated block's forces on the ground are released over
   its stage (scaled from 1 to 0), not in one jump.
 * **Geostatic stage** (``reset_displacements``): at its end the displacements are discarded and
-  the strains kept (each existing cell's shift s becomes s − u).
+  the strains kept (each existing cell's shift s becomes s − u). Or K₀ initial stresses of level
+  ground (``initial_stress=[K0(soil, k0, surface)]``): σ₀ carried at zero strain, in equilibrium
+  with the ground's weight, so that the stage starts and ends at zero displacement.
 * **Strain-free activation of continuum.** A cell that appears takes the current displacement of
   its nodes as its activation shift s. Approach I (seed §3.1.2, small construction
   deformations): strains of u − s on the mesh, the original mesh being the reference. Approach
@@ -68,13 +70,37 @@ class Stage:
     remove: [(solid part, cell group), …] excavated in it — their forces on the remaining body are
     released over the stage (scaled from 1 to 0 with λ), not in one jump;
     reset_displacements: at its end the displacements are discarded and the strains (stresses)
-    kept — a geostatic stage, after which displacements count from the initial state."""
+    kept — a geostatic stage, after which displacements count from the initial state;
+    initial_stress: [:class:`K0`, …] geostatic stresses of level ground given to solids at the
+    start of the stage (the alternative to a gravity stage with ``reset_displacements``)."""
 
     name: str
     add: Sequence = field(default_factory=list)
     remove: Sequence = field(default_factory=list)
     driver: LoadControl = field(default_factory=lambda: LoadControl(steps=1))
     reset_displacements: bool = False
+    initial_stress: Sequence = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class K0:
+    """Initial stresses of level ground in the cells of a solid (the K₀ procedure): σ_v = −γ (surface
+    − z) along the vertical (the last axis), σ_h = ``k0`` σ_v, no shear; γ = ``unit_weight``, or
+    (None) ρ|g| of the solid's density and gravity. With the solid's gravity they are in
+    equilibrium at zero displacement: the stage that sets them starts, and ends, there (for level
+    ground; elsewhere the stage finds the equilibrium the ground's weight and σ₀ leave)."""
+
+    part: object
+    k0: float
+    surface: float
+    unit_weight: float | None = None
+
+    def apply(self) -> None:
+        model = self.part.model
+        if not getattr(model, "continuum", False):
+            raise ValueError(f"K0 initial stress on {self.part.kind} '{self.part.name}': only solids carry "
+                             "initial stresses")
+        model.set_k0_stress(self.k0, self.surface, self.unit_weight)
 
 
 def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: Sequence = (),
@@ -133,6 +159,8 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
                 raise ValueError(f"solve_stages: stage '{stage.name}' removes '{group}' of {ref.kind} "
                                  f"'{ref.name}', which does not exist (entirely) at that stage")
             staged[id(ref.model)][1][cells] = False
+        for k0 in stage.initial_stress:
+            k0.apply()
         resuming = resume is not None and index == resume.stage
         if resume is not None and index < resume.stage:  # done before the checkpoint
             for model, exists in staged.values():

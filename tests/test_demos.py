@@ -7,6 +7,7 @@ script and must reproduce the values it recorded serially (``tip_values.json``).
 """
 import importlib.util
 import json
+import re
 import os
 import subprocess
 import sys
@@ -154,6 +155,7 @@ def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
                 "tests/test_self_weight.py", "tests/test_cell_checks.py", "tests/test_stabilisation.py",
                 "tests/test_stability.py", "tests/test_convergence_scale.py", "tests/test_staging.py"],
                tmp_path)
-    summaries = [line for line in out.splitlines() if " passed" in line and line.rstrip().endswith("s")]
+    # pytest's closing line on each rank: "N passed, M skipped in 62.63s" (+ " (0:01:02)" past a minute)
+    summaries = [line for line in out.splitlines() if re.search(r"\d+ passed.* in [\d.]+s( \([\d:]+\))?\s*$", line)]
     assert len(summaries) == 2, out[-3000:]
     assert not any("failed" in line or "error" in line for line in summaries), summaries

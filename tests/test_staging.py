@@ -9,7 +9,7 @@ from petsc4py import PETSc
 import dolfinx_corot as dc
 from dolfinx_corot.io.mesh import from_gmsh
 from dolfinx_corot.assembly import make_system
-from dolfinx_corot.staging import Stage, solve_stages
+from dolfinx_corot.staging import K0, Stage, solve_stages
 from fd import tangent_and_fd
 
 comm = MPI.COMM_WORLD
@@ -169,8 +169,8 @@ def test_bad_stage_input_is_named():
 def test_staged_tangent_matches_finite_differences(approach):
     """The tangent of a staged column at large strain — the top layer activated on the settled one,
     its shift s ≠ 0 and, for approach II, a reference shift m ≠ s as a mapping makes it
-    (F = (I + ∇m + ∇(u − s))(I + ∇m)⁻¹ over X + m) — against central differences of the residual at
-    a perturbed state, free dofs (1e-6 of its largest entry)."""
+    (F = (I + ∇m + ∇(u − s))(I + ∇m)⁻¹ over X + m), with K₀ initial stresses (P₀ = F σ₀) — against
+    central differences of the residual at a perturbed state, free dofs (1e-6 of its largest entry)."""
     sc, soil = _column_scene(2, large=True, modulus=1500.0)
     solve_stages(sc, [Stage(f"layer {k}", add=[(soil, f"layer{k}")]) for k in (1, 2)], approach=approach)
     model = soil.model
@@ -178,6 +178,7 @@ def test_staged_tangent_matches_finite_differences(approach):
     rng = np.random.default_rng(5)
     m = model.activation_reference.x.array
     m[:] += rng.uniform(-0.05, 0.05, m.shape) * (np.abs(model.activation_shift.x.array) > 0.0)
+    model.set_k0_stress(0.6, surface=H, unit_weight=RHO * G)  # σ₀ up to 160: its work F σ₀ : ∇v too
     system = make_system(sc.model, solver="direct")
     try:
         model.state.x.array[:] += rng.uniform(-0.02, 0.02, model.state.x.array.shape)
@@ -965,3 +966,59 @@ def test_a_shell_strip_added_on_settled_ground(approach):
     assert all(np.abs(staged[p] - u).max() < 1e-9 * scale for p, u in reference.items())
     assert abs(after - settled) > 1e-3 * abs(settled)  # the strip bent into the trough acts on it
     assert _shell_forces(shells) > 0.01 * resultant
+
+
+# -- K0 initial stresses ---------------------------------------------------------------------------
+@pytest.mark.parametrize("large", [False, True])
+def test_k0_initial_stresses_of_level_ground_are_in_equilibrium_with_its_weight(large):
+    """The K₀ procedure: level ground (the pit's cells still there, top at HG) given
+    σ_v = −ρg (HG − y), σ_h = K₀ σ_v with K₀ = 0.7 (not the elastic ν/(1 − ν) = 1/3) and its weight:
+    the stage starts and ends at zero displacement (1e-12 of ρg HG²/E), and every cell's stress at
+    its centre is the closed form (1e-9: the round-off of that zero) — small strain and
+    co-rotational (SVK). The excavation
+    that follows releases the pit's σ₀ over its steps: halfway the floor has heaved half its heave."""
+    sc = dc.Scene(large_rotations=large, linear_solver="direct")
+    material = dc.SaintVenantKirchhoff(E, NU, density=RHO) if large else dc.Elastic(E, NU, density=RHO)
+    soil = sc.add_solid(_ground(with_pit=True), material=material, degree=1)
+    sc.fix(soil, "base")
+    sc.fix(soil, "sides", dofs=("ux",))
+    sc.gravity(soil, (0.0, -G))
+    sc.monitor("floor", soil, "floor")
+    k0 = 0.7
+    snapshots = []
+    results = solve_stages(sc, [Stage("K0", add=[(soil, "ground"), (soil, "pit")],
+                                      initial_stress=[K0(soil, k0, surface=HG)]),
+                                Stage("excavation", remove=[(soil, "pit")], driver=dc.LoadControl(steps=2))],
+                           approach="II", on_step=lambda stage, row: snapshots.append((stage.name, _nodal(soil),
+                                                                                       _stresses(soil))))
+    assert results[0].history.rows[-1]["iterations"] <= 1
+    _, u_k0, s_k0 = snapshots[0]
+    assert max(np.abs(u).max() for u in u_k0.values()) < 1e-12 * RHO * G * HG**2 / E
+    scale = RHO * G * HG
+    for (x, y), s in s_k0.items():
+        sv = -RHO * G * (HG - y)
+        assert np.abs(s - np.array([[k0 * sv, 0.0], [0.0, sv]])).max() < 1e-9 * scale
+    heave = [row["floor_uy"] for row in results[1].history.rows]
+    assert heave[-1] > 1e-4 * HG
+    if not large:
+        assert heave[0] == pytest.approx(0.5 * heave[-1], rel=1e-9)
+
+
+def test_k0_input_is_checked_by_name():
+    """K₀ on a structure, a surface below the top of the mesh, and a unit weight that cannot be
+    taken from the materials are refused with the culprit named."""
+    sc, soil = _ground_scene(with_pit=True)
+    with pytest.raises(ValueError, match="the mesh rises to 4, above the ground's surface 3"):
+        solve_stages(sc, [Stage("K0", add=[(soil, "ground"), (soil, "pit")], initial_stress=[K0(soil, 0.5, 3.0)])])
+    sc = dc.Scene(large_rotations=False, linear_solver="direct")
+    soil = sc.add_solid(_ground(with_pit=True), "ground", material=dc.Elastic(E, NU, density=RHO), degree=1)
+    sc.add_solid(soil.model.tmesh, "pit", material=dc.Elastic(E, NU, density=2 * RHO), degree=1)
+    sc.gravity(soil, (0.0, -G))
+    with pytest.raises(ValueError, match=r"give unit_weight= \(the solid has 2 densities"):
+        solve_stages(sc, [Stage("K0", add=[(soil, "ground"), (soil, "pit")], initial_stress=[K0(soil, 0.5, HG)])])
+    from dolfinx_corot.io.gmsh_models import polyline
+    sc = dc.Scene()
+    beam = sc.add_beam(polyline([[0.0, 0.0], [1.0, 0.0]], 2), "beam", section=dc.Rectangle(0.1, 0.1),
+                       material=dc.Elastic(1.0e3))
+    with pytest.raises(ValueError, match="K0 initial stress on beam 'beam': only solids carry initial stresses"):
+        solve_stages(sc, [Stage("K0", add=[(beam, "beam")], initial_stress=[K0(beam, 0.5, 0.0)])])

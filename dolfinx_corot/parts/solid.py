@@ -36,6 +36,7 @@ import dolfinx.fem
 import dolfinx.fem.petsc
 import dolfinx.la
 
+from .. import validate
 from ..assembly import petsc
 from ..continuum.kinematics import deformation_gradient
 from ..continuum.laws import first_piola, lame
@@ -191,6 +192,65 @@ class Solid(AdditiveState, Part):
 
     def _load_amplitudes(self) -> list:
         return [amp for *_, amp in self._tractions + self._body + self._point_loads]
+
+    # -- initial (K₀) stress ---------------------------------------------------------------
+    initial_stress = None  # σ₀ (UFL) the cells carry at zero strain, or None
+
+    def set_k0_stress(self, k0: float, surface: float, unit_weight: float | None = None) -> None:
+        """The geostatic stress of level ground as an initial stress σ₀ carried at zero strain:
+        σ_v = −γ (surface − z) along the vertical (the last axis), σ_h = K₀ σ_v along the others,
+        no shear. γ: ``unit_weight``, or (None) ρ|g| of the solid's one density and the gravity
+        declared on it. With that gravity σ₀ is in equilibrium at zero displacement (div σ₀ + ρg = 0,
+        no traction on the surface), the supports taking σ_h on the sides."""
+        label = f"K0 initial stress of solid '{self.parts[0].name if self.parts else ''}'"
+        validate.positive(label, "k0", k0, allow_zero=True)
+        if not np.isfinite(surface):
+            raise ValueError(f"{label}: surface = {surface} must be a finite elevation")
+        if unit_weight is None:
+            unit_weight = self._unit_weight(label)
+        validate.positive(label, "unit_weight", unit_weight)
+        top = self.comm.allreduce(float(self.V.mesh.geometry.x[:, self.gdim - 1].max(initial=-np.inf)), op=MPI.MAX)
+        if top > surface + 1e-9 * max(1.0, abs(surface)):
+            raise ValueError(f"{label}: the mesh rises to {top:.6g}, above the ground's surface {surface:.6g} "
+                             "(level ground: give the elevation of its top)")
+        x = ufl.SpatialCoordinate(self.V.mesh)
+        sv = -float(unit_weight) * (float(surface) - x[self.gdim - 1])
+        diagonal = [float(k0) * sv] * (self.gdim - 1) + [sv]
+        self.initial_stress = ufl.as_matrix([[diagonal[i] if i == j else 0.0 for j in range(self.gdim)]
+                                             for i in range(self.gdim)])
+        self._forms = None
+
+    def _unit_weight(self, label: str) -> float:
+        """ρ|g| of the solid's one density and its one gravity (pointing down the last axis)."""
+        n = self.tmesh.mesh.topology.index_map(self.tdim).size_local
+        rho = self.density.x.array[self._cell_dof[:n]]
+        values = np.unique(np.concatenate(self.comm.allgather(rho)))
+        gravity = [b for _, b, by_density, _ in self._body if by_density]
+        if len(values) != 1 or values[0] <= 0.0 or len(gravity) != 1:
+            raise ValueError(f"{label}: give unit_weight= (the solid has {len(values)} densities "
+                             f"{values[:3].tolist()} and {len(gravity)} gravity load(s); the unit weight is taken "
+                             "from them only for one positive density and one gravity)")
+        g = gravity[0]
+        if np.any(g[:-1] != 0.0) or g[-1] >= 0.0:
+            raise ValueError(f"{label}: the gravity {g.tolist()} does not point down the last axis (level ground)")
+        return float(values[0] * -g[-1])
+
+    def _initial_stress_work(self, u, v):
+        """The work of σ₀ on ∇v: σ₀ : ∇v at small strain; at large rotations σ₀ is a second
+        Piola–Kirchhoff stress of the reference, P₀ = F σ₀ (F and the reference as in the cell's
+        staged kinematics, if any)."""
+        S0 = self.initial_stress
+        if self.existing is None:
+            if not self.large_rotations:
+                return ufl.inner(S0, self._gradient(v))
+            F = ufl.Identity(self.gdim) + self._gradient(u)
+            return ufl.inner(ufl.dot(F, S0), self._gradient(v))
+        measure, J0 = self._staged_kinematics(u)
+        if not self.large_rotations:
+            return ufl.inner(S0, ufl.grad(v))
+        if J0 is None:
+            return ufl.inner(ufl.dot(measure, S0), ufl.grad(v))
+        return ufl.det(J0) * ufl.inner(ufl.dot(measure, S0), ufl.dot(ufl.grad(v), ufl.inv(J0)))
 
     def load_values(self, where: str, force, moment) -> np.ndarray:
         if moment is not None:
@@ -392,16 +452,21 @@ class Solid(AdditiveState, Part):
         if self.existing is not None:
             lmbda, mu = lame(self.E, self.nu)
             measure, _ = self._staged_kinematics(u)
+            S0 = self.initial_stress
             if not self.large_rotations:
                 sigma = lmbda * ufl.tr(measure) * ufl.Identity(self.gdim) + 2.0 * mu * measure
+                sigma = sigma if S0 is None else sigma + S0
             else:
-                sigma = ufl.dot(first_piola(self.law, measure, lmbda, mu), measure.T) / ufl.det(measure)
+                P = first_piola(self.law, measure, lmbda, mu)
+                P = P if S0 is None else P + ufl.dot(measure, S0)
+                sigma = ufl.dot(P, measure.T) / ufl.det(measure)
             sigma = self.existing * sigma
         elif self.large_rotations:
             F = ufl.Identity(self.gdim) + self._gradient(u)
-            sigma = ufl.dot(self.stress(u), F.T) / ufl.det(F)
+            P = self.stress(u) if self.initial_stress is None else self.stress(u) + ufl.dot(F, self.initial_stress)
+            sigma = ufl.dot(P, F.T) / ufl.det(F)
         else:
-            sigma = self.stress(u)
+            sigma = self.stress(u) if self.initial_stress is None else self.stress(u) + self.initial_stress
         cell = self.V.mesh.ufl_cell().cellname()
         centre = {"triangle": [[1 / 3, 1 / 3]], "quadrilateral": [[0.5, 0.5]],
                   "tetrahedron": [[0.25, 0.25, 0.25]], "hexahedron": [[0.5, 0.5, 0.5]]}[cell]
@@ -429,9 +494,13 @@ class Solid(AdditiveState, Part):
             u, v, du = self.state, ufl.TestFunction(self.V), ufl.TrialFunction(self.V)
             dx = ufl.dx(metadata={"quadrature_degree": self.quadrature})
             if self.existing is not None:
-                integrand = self.existing * self._staged_integrand(u, v)
+                integrand = self._staged_integrand(u, v)
             else:
                 integrand = ufl.inner(self.stress(u), self._gradient(v))
+            if self.initial_stress is not None:
+                integrand = integrand + self._initial_stress_work(u, v)
+            if self.existing is not None:
+                integrand = self.existing * integrand
             if self._shifted:
                 integrand = ufl.det(ufl.Identity(self.gdim) + ufl.grad(self.reference_shift)) * integrand
             residual = integrand * dx

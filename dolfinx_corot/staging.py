@@ -56,7 +56,7 @@ from mpi4py import MPI
 from .assembly import make_system
 from .result import Result
 from .solvers import CheckpointError, ConvergenceError, CriticalPoint, LoadControl, solve
-from .solvers.run import read_checkpoint
+from .solvers.run import read_checkpoint_on_all_ranks
 
 APPROACHES = ("I", "II")
 
@@ -285,16 +285,7 @@ class _StageFile:
     @classmethod
     def read(cls, path: str, comm, approach: str, stages) -> "_StageFile":
         """The staged part of a checkpoint, checked against this run's approach and stages."""
-        found = None
-        if comm.rank == 0:
-            try:
-                found = read_checkpoint(path)
-            except CheckpointError as err:
-                found = err
-        found = comm.bcast(found, root=0)
-        if isinstance(found, CheckpointError):
-            raise found
-        meta, arrays = found
+        meta, arrays = read_checkpoint_on_all_ranks(path, comm)
         st = meta.get("staging")
         if st is None:
             raise CheckpointError(f"the checkpoint {path} was written by a run without stages: restart it with solve")

@@ -21,6 +21,16 @@ def _physical_group(dim: int, tags, tag: int, name: str) -> None:
     gmsh.model.setPhysicalName(dim, tag, name)
 
 
+def _meshes(gdim: int, structures: int | None = None):
+    """The meshed gmsh model (on rank 0) read as a mesh of its cells and, with ``structures``, of its
+    cells of that dimension too (beams, shells); gmsh is finalized."""
+    tm = from_gmsh(gmsh.model, gdim, comm=comm)
+    other = None if structures is None else from_gmsh(gmsh.model, gdim, comm=comm, dim=structures)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm if structures is None else (tm, other)
+
+
 def _column(n: int):
     """A column WIDTH × H of n layers (one quadrilateral each, shared nodes): cell groups layer1…n
     from the bottom, line groups base and sides, point group 'z<k>' at the left node of height k·h."""
@@ -54,10 +64,7 @@ def _column(n: int):
         for k in range(1, n + 1):
             group(0, [left[k]], n + 2 + k, f"z{k}")
         gmsh.model.mesh.generate(2)
-    tm = from_gmsh(gmsh.model, 2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
-    return tm
+    return _meshes(2)
 
 
 def _column_scene(n: int, large: bool, modulus: float = E):
@@ -241,11 +248,7 @@ def _ground(with_pit: bool, n: int = 2, beams: bool = False):
         if with_pit and not beams:
             group(0, [pts[0, 2]], 6, "top")
         gmsh.model.mesh.generate(2)
-    tm = from_gmsh(gmsh.model, 2, comm=comm)
-    lines = from_gmsh(gmsh.model, 2, comm=comm, dim=1) if beams else None
-    if comm.rank == 0:
-        gmsh.finalize()
-    return (tm, lines) if beams else tm
+    return _meshes(2, 1 if beams else None)
 
 
 def _ground_scene(with_pit: bool):
@@ -495,11 +498,7 @@ def _pit_wall_plate():
         group(0, [b1], 9, "wall_top")
         group(0, [pts[4, 1]], 10, "plate_mid")
         gmsh.model.mesh.generate(2)
-    tm = from_gmsh(gmsh.model, 2, comm=comm)
-    lines = from_gmsh(gmsh.model, 2, comm=comm, dim=1)
-    if comm.rank == 0:
-        gmsh.finalize()
-    return tm, lines
+    return _meshes(2, 1)
 
 
 def _fill_against_a_wall(approach: str):
@@ -640,9 +639,7 @@ def test_mapping_refuses_new_cells_that_nothing_holds():
         _physical_group(2, [surfaces[1]], 2, "block")
         _physical_group(1, [base], 3, "base")
         gmsh.model.mesh.generate(2)
-    tm = from_gmsh(gmsh.model, 2, comm=comm)
-    if comm.rank == 0:
-        gmsh.finalize()
+    tm = _meshes(2)
     sc = dc.Scene(large_rotations=True, linear_solver="direct")
     soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU), degree=1)
     sc.fix(soil, "base")
@@ -655,12 +652,12 @@ class Killed(Exception):
     """Raised from on_step: the run dies after a step (its checkpoint holds the step before)."""
 
 
-def _box_in_pit_scene(slaves_on_fill: bool = True):
+def _box_in_pit_scene(slaves_on_fill: bool = True, size: float = 1.0):
     """A coarse box frame in a pit, filled in two layers (the frame-filling demos' scene): geostatic
     stage (reset), excavation (U_e), frame (U_os), two fill layers with frame–fill contact (slaves
     on the fill's face, or on the frame)."""
     from dolfinx_corot.io.gmsh_models import box_in_pit
-    tm, lines = box_in_pit(12.0, 8.0, 8.0, 4.0, 4.0, 2.0, 0.2, 1, 1, 1.0)
+    tm, lines = box_in_pit(12.0, 8.0, 8.0, 4.0, 4.0, 2.0, 0.2, 1, 1, size)
     sc = dc.Scene(large_rotations=True, linear_solver="direct")
     soil = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(50e6, 0.3, density=2000.0), degree=1)
     fill = sc.add_solid(tm, "fill", material=dc.SaintVenantKirchhoff(10e6, 0.3, density=1800.0), degree=1)
@@ -734,7 +731,7 @@ def test_a_staged_run_killed_and_restarted_reproduces_the_uninterrupted_one(tmp_
         assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()
 
 
-def test_a_staged_restart_refuses_another_approach_other_stages_or_a_plain_solve(tmp_path):
+def test_a_staged_restart_refuses_another_approach_other_stages_a_plain_solve_or_another_mesh(tmp_path):
     sc, stages, initial, _ = _box_in_pit_scene()
     path = comm.bcast(str(tmp_path / "staged.npz") if comm.rank == 0 else None, root=0)
 
@@ -752,6 +749,9 @@ def test_a_staged_restart_refuses_another_approach_other_stages_or_a_plain_solve
         solve_stages(sc, renamed, approach="II", initial=initial, restart=path)
     with pytest.raises(dc.CheckpointError, match="written by a staged run: restart it with solve_stages"):
         dc.solve(sc, dc.LoadControl(steps=1), restart=path)
+    sc, stages, initial, _ = _box_in_pit_scene(size=0.8)  # another mesh
+    with pytest.raises(dc.CheckpointError, match="was written for another scene"):
+        solve_stages(sc, stages, approach="II", initial=initial, restart=path)
 
 
 def test_a_system_vector_goes_through_a_checkpoint_file_unchanged():
@@ -903,11 +903,7 @@ def _ground_3d():
             gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, tags), name)
         gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
         gmsh.model.mesh.generate(3)
-    tm = from_gmsh(gmsh.model, 3, comm=comm)
-    surfaces = from_gmsh(gmsh.model, 3, comm=comm, dim=2)
-    if comm.rank == 0:
-        gmsh.finalize()
-    return tm, surfaces
+    return _meshes(3, 2)
 
 
 def _ground_and_shell(large: bool):

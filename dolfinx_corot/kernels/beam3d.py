@@ -27,7 +27,7 @@ from ..corotation import frame3d
 from ..corotation.transform import force, stiffness
 from ..elements import beam3d as law
 from .spatial import H, last_node_columns, nodal_states, perturb, rotation_vector_dofs, since_activation
-from .ufcx import tabulate_tensor_kernels
+from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
 NDOF = 12
 NSTATE = 7
@@ -157,12 +157,5 @@ def _tabulate_staged(w, c, X, f, K, tangent):
     _evaluate(Xa, Sa, w[2 * NSTATE:NCOEF], c[0] != 0.0, tangent, f, K)
 
 
-_staged = None
-
-
-def staged_kernels():
-    """(vector_kernel, matrix_kernel) of staged elements (compiled on first use)."""
-    global _staged
-    if _staged is None:
-        _staged = tabulate_tensor_kernels(_tabulate_staged, NDOF, NCOEF + 2 * NSTATE, 2)
-    return _staged
+# (vector_kernel, matrix_kernel) of staged elements, compiled on first use
+staged_kernels = lazy_kernels(_tabulate_staged, NDOF, NCOEF + 2 * NSTATE, 2)

@@ -27,7 +27,7 @@ import numpy as np
 from ..corotation import frame2d
 from ..corotation.transform import stiffness
 from ..elements import line2d as law
-from .ufcx import tabulate_tensor_kernels
+from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
 NDOF = 6
 NCOEF = NDOF + law.NPROPS
@@ -111,12 +111,5 @@ def _tabulate_staged(w, c, X, f, K, tangent):
              c[0] != 0.0, f, K)
 
 
-_staged = None
-
-
-def staged_kernels():
-    """(vector_kernel, matrix_kernel) of staged elements (compiled on first use)."""
-    global _staged
-    if _staged is None:
-        _staged = tabulate_tensor_kernels(_tabulate_staged, NDOF, NCOEF + NDOF, 2)
-    return _staged
+# (vector_kernel, matrix_kernel) of staged elements, compiled on first use
+staged_kernels = lazy_kernels(_tabulate_staged, NDOF, NCOEF + NDOF, 2)

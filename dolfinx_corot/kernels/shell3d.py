@@ -32,7 +32,7 @@ from ..corotation.transform import linear_force, stiffness
 from ..elements import shell_triangle as law
 from .spatial import (H, last_node_columns, nodal_states, pack_constants, perturb, rotation_vector_dofs,
                       since_activation, unpack_constants)
-from .ufcx import tabulate_tensor_kernels
+from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
 NDOF = 18
 NSTATE = 7
@@ -186,12 +186,5 @@ def _tabulate_staged(w, c, X, f, K, tangent):
         corotational_cached(Xa, Sa, props, edata, f, K, tangent)
 
 
-_staged = None
-
-
-def staged_kernels():
-    """(vector_kernel, matrix_kernel) of staged elements (compiled on first use)."""
-    global _staged
-    if _staged is None:
-        _staged = tabulate_tensor_kernels(_tabulate_staged, NDOF, NCOEF + 3 * NSTATE, 3)
-    return _staged
+# (vector_kernel, matrix_kernel) of staged elements, compiled on first use
+staged_kernels = lazy_kernels(_tabulate_staged, NDOF, NCOEF + 3 * NSTATE, 3)

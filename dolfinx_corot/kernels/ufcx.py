@@ -79,3 +79,16 @@ def tabulate_tensor_kernels(tabulate, ndof: int, ncoef: int, nnode: int, nconst:
         fn.__doc__ = f"ufcx tabulate_tensor of the {what} of {module}."
         made.append(numba.cfunc(signature, nopython=True, cache=True)(fn))
     return tuple(made)
+
+
+def lazy_kernels(tabulate, ndof: int, ncoef: int, nnode: int):
+    """A function returning :func:`tabulate_tensor_kernels` of ``tabulate``, compiled on its first
+    call (kernels that only some analyses need, e.g. those of staged elements)."""
+    made = []
+
+    def kernels():
+        if not made:
+            made.extend(tabulate_tensor_kernels(tabulate, ndof, ncoef, nnode))
+        return tuple(made)
+
+    return kernels

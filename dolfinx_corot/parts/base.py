@@ -498,10 +498,11 @@ class Part:
     def set_staging_arrays(self, arrays: dict) -> None:
         """Restore :meth:`staging_arrays`' output (every rank holds the arrays)."""
 
-    def _cells_to_global(self, blocks: np.ndarray, values: np.ndarray) -> dict | None:
-        """Per-cell nodal values in a partition-independent order, on rank 0: ``blocks`` (local
-        cells, n) the local blocks of each cell's nodes, ``values`` (local cells, n, k). Cells are
-        ordered by their input index, the nodes of each cell by their input number."""
+    def _cells_to_global(self, blocks: np.ndarray, values: np.ndarray) -> dict:
+        """Per-cell nodal values in a partition-independent order, on rank 0 (``cell_*`` arrays;
+        {} elsewhere): ``blocks`` (local cells, n) the local blocks of each cell's nodes,
+        ``values`` (local cells, n, k). Cells are ordered by their input index, the nodes of each
+        cell by their input number."""
         n_owned = self.V.mesh.topology.index_map(self.tdim).size_local
         cells = np.asarray(self.V.mesh.topology.original_cell_index, dtype=np.int64)[:n_owned]
         keys = self.node_keys()[blocks[:n_owned]]
@@ -510,14 +511,17 @@ class Part:
         values = np.take_along_axis(np.asarray(values)[:n_owned], order[:, :, None], axis=1)
         found = self.comm.gather((cells, keys, values), root=0)
         if self.comm.rank != 0:
-            return None
+            return {}
         cells, keys, values = (np.concatenate(a) for a in zip(*found))
         first = np.argsort(cells)
-        return {"cells": cells[first], "nodes": keys[first], "values": values[first]}
+        return {"cell_cells": cells[first], "cell_nodes": keys[first], "cell_values": values[first]}
 
-    def _cells_from_global(self, blocks: np.ndarray, saved: dict, label: str) -> np.ndarray:
-        """The per-cell nodal values of :meth:`_cells_to_global` for the local cells (owned and
-        ghost) whose nodes are ``blocks``, (local cells, n, k); a file of another mesh is refused."""
+    def _cells_from_global(self, blocks: np.ndarray, arrays: dict) -> np.ndarray:
+        """The per-cell nodal values of :meth:`_cells_to_global` (in ``arrays``) for the local
+        cells (owned and ghost) whose nodes are ``blocks``, (local cells, n, k); a file of another
+        mesh is refused."""
+        saved = {k[len("cell_"):]: v for k, v in arrays.items() if k.startswith("cell_")}
+        label = f"staged {self.kind_name} part '{self.parts[0].name if self.parts else ''}'"
         cells = np.asarray(self.V.mesh.topology.original_cell_index, dtype=np.int64)[: len(blocks)]
         pos = np.searchsorted(saved["cells"], cells)
         keys = self.node_keys()[blocks]

@@ -279,15 +279,12 @@ class LineFrame(Part):
         if self.activation is None:
             return {}
         act = self._activation_values()[self.activation.function_space.dofmap.list.array]
-        found = self._cells_to_global(self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell), act)
-        return {} if found is None else {f"cell_{k}": v for k, v in found.items()}
+        return self._cells_to_global(self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell), act)
 
     def set_staging_arrays(self, arrays: dict) -> None:
         if self.activation is None:
             return
-        saved = {k[len("cell_"):]: v for k, v in arrays.items() if k.startswith("cell_")}
-        values = self._cells_from_global(self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell), saved,
-                                         f"staged {self.kind_name} part '{self.parts[0].name if self.parts else ''}'")
+        values = self._cells_from_global(self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell), arrays)
         self._activation_values()[self.activation.function_space.dofmap.list.array] = values
         self._forms = None
 

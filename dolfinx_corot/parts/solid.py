@@ -372,8 +372,7 @@ class Solid(AdditiveState, Part):
         cg = self.V.dofmap.list.array.reshape(-1, n)
         values = np.concatenate([f.x.array.reshape(-1, self.gdim)[dg]
                                  for f in (self.activation_shift, self.activation_reference)], axis=2)
-        found = self._cells_to_global(cg, values)
-        return {} if found is None else {f"cell_{k}": v for k, v in found.items()}
+        return self._cells_to_global(cg, values)
 
     def set_staging_arrays(self, arrays: dict) -> None:
         if self.existing is None:
@@ -381,8 +380,7 @@ class Solid(AdditiveState, Part):
         n, gdim = self.nodes_per_cell, self.gdim
         dg = self.activation_shift.function_space.dofmap.list.array.reshape(-1, n)
         cg = self.V.dofmap.list.array.reshape(-1, n)
-        saved = {k[len("cell_"):]: v for k, v in arrays.items() if k.startswith("cell_")}
-        values = self._cells_from_global(cg, saved, f"staged solid '{self.parts[0].name if self.parts else ''}'")
+        values = self._cells_from_global(cg, arrays)
         self.activation_shift.x.array.reshape(-1, gdim)[dg] = values[:, :, :gdim]
         self.activation_reference.x.array.reshape(-1, gdim)[dg] = values[:, :, gdim:]
 

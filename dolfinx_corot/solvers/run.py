@@ -79,6 +79,20 @@ def read_checkpoint(path: str) -> tuple[dict, dict]:
     return meta, arrays
 
 
+def read_checkpoint_on_all_ranks(path: str, comm) -> tuple[dict, dict]:
+    """:func:`read_checkpoint` on rank 0, its result (or its refusal) on every rank."""
+    found = None
+    if comm.rank == 0:
+        try:
+            found = read_checkpoint(path)
+        except CheckpointError as err:
+            found = err
+    found = comm.bcast(found, root=0)
+    if isinstance(found, CheckpointError):
+        raise found
+    return found
+
+
 class Run:
     """Bookkeeping shared by the drivers: history rows, totals, failure, checkpoints."""
 
@@ -175,17 +189,7 @@ class Run:
     def load(self, path: str, driver_name: str) -> tuple[dict, dict]:
         """Restore configuration, contribution states, history and counters from a checkpoint;
         returns (driver state, arrays). Refuses a file of another scene or another driver."""
-        comm = self.system.comm
-        found = None
-        if comm.rank == 0:
-            try:
-                found = read_checkpoint(path)
-            except CheckpointError as err:
-                found = err
-        found = comm.bcast(found, root=0)
-        if isinstance(found, CheckpointError):
-            raise found
-        meta, arrays = found
+        meta, arrays = read_checkpoint_on_all_ranks(path, self.system.comm)
         if bool(meta["large_rotations"]) != self.scene.large_rotations:
             raise CheckpointError(
                 f"the checkpoint {path} was computed with large_rotations={meta['large_rotations']}; switching "

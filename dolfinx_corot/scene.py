@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .conditions import Condition
 from .contact.interface import Contact, Interface
 from .contact.laws import Penalty
 from .contact.pair import ContactPair
@@ -35,6 +36,11 @@ from .sections import Section
 from .stabilisation import Stabilisation, Stabiliser
 
 KINEMATICS = ("bernoulli", "timoshenko")
+
+
+def _on(part: PartRef, where: str) -> str:
+    """'on <group> of <kind> <name>' (a condition's label)."""
+    return f"on '{where}' of {part.kind}" + (f" '{part.name}'" if part.name else "")
 
 
 REDUCTIONS = {
@@ -198,17 +204,21 @@ class Scene:
             raise TypeError(f"{kind} '{where}': material must be dc.Elastic, got {type(material).__name__}")
 
     # -- conditions ------------------------------------------------------------
-    def fix(self, part: PartRef, where: str, dofs: tuple[str, ...] | None = None) -> None:
-        """Support: zero displacement/rotation of ``dofs`` (default all) at the nodes of ``where``."""
+    def fix(self, part: PartRef, where: str, dofs: tuple[str, ...] | None = None) -> Condition:
+        """Support: zero displacement/rotation of ``dofs`` (default all) at the nodes of ``where``.
+        Returns the support as a :class:`~dolfinx_corot.conditions.Condition`, which construction
+        stages may add (it then holds the nodes where they are) or remove (its reaction is released
+        over the stage)."""
         model = part.model
         names = model.dof_names
         dofs = names if dofs is None else tuple(dofs)
         bad = [d for d in dofs if d not in names]
         if bad:
             raise ValueError(f"fix '{where}': unknown dof(s) {bad}; this part has {names}")
-        model.fix(where, tuple(names.index(d) for d in dofs))
+        label = f"{_on(part, where)} ({', '.join(dofs)})"
+        return model.fix(where, tuple(names.index(d) for d in dofs), Condition("support", label))
 
-    def prescribe(self, part: PartRef, where: str, amplitude=None, **values) -> None:
+    def prescribe(self, part: PartRef, where: str, amplitude=None, **values) -> Condition:
         """Prescribed displacement/rotation at the nodes of ``where``: a number scaled by the load
         factor (or by ``amplitude(λ)``, a :class:`dolfinx_corot.Amplitude`), or a function
         ``motion(load_factor, stage)`` of the load factor and the construction stage (None
@@ -217,45 +227,57 @@ class Scene:
         Example: ``scene.prescribe(beam, "tip", uy=-1.0)`` (displacement control:
         λ = 1 moves the tip by −1; read the force with :meth:`monitor_reaction`);
         ``scene.prescribe(beam, "tip", uy=lambda lam, stage: -0.1 * lam**2)``.
+
+        Returns the motion as a :class:`~dolfinx_corot.conditions.Condition` (construction stages
+        may add or remove it; in a staged run ``stage`` is the name of the stage).
         """
         model = part.model
         names = model.dof_names
         bad = [d for d in values if d not in names]
         if bad or not values:
             raise ValueError(f"prescribe '{where}': give one or more of {names} as keywords; got {list(values)}")
+        condition = Condition("motion", f"{_on(part, where)} ({', '.join(values)})")
         for dof, value in values.items():
             if callable(value):
                 if amplitude is not None:
                     raise ValueError(f"prescribe '{where}': {dof} is a function of the load factor already; "
                                      "an amplitude does not apply to it")
-                model.prescribe(where, names.index(dof), 0.0, None, function=value)
+                model.prescribe(where, names.index(dof), 0.0, None, function=value, condition=condition)
                 continue
             if not np.isfinite(value):
                 raise ValueError(f"prescribe '{where}': {dof} = {value} is not finite")
-            model.prescribe(where, names.index(dof), float(value), amplitude)
+            model.prescribe(where, names.index(dof), float(value), amplitude, condition=condition)
         self._prescribed += 1
+        return condition
 
-    def load(self, part: PartRef, where: str, force=None, moment=None, amplitude=None, traction=None) -> None:
+    def load(self, part: PartRef, where: str, force=None, moment=None, amplitude=None, traction=None) -> Condition:
         """Dead point force and moment at each node of ``where``, scaled by the load factor λ
         or, with an ``amplitude`` (:class:`dolfinx_corot.Amplitude`), by amplitude(λ).
 
         2D: force (fx, fy), moment mz (a number). 3D: force (fx, fy, fz),
         moment (mx, my, mz), a fixed spatial vector. Solids: ``traction`` (per unit
         reference area, a facet group) or ``force`` at each node of the group.
+
+        Returns the load as a :class:`~dolfinx_corot.conditions.Condition` (construction stages
+        may add it — applied over that stage — or remove it — taken off over that stage).
         """
         model = part.model
+        condition = Condition("load", _on(part, where))
         if traction is not None:
-            model.add_traction(where, finite_vector(f"load '{where}'", "traction", traction, model.gdim), amplitude)
+            model.add_traction(where, finite_vector(f"load '{where}'", "traction", traction, model.gdim), amplitude,
+                               condition)
             self._loads += 1
         values = model.load_values(where, force, moment)
         if values is not None:
-            model.add_load(where, values, amplitude)
+            model.add_load(where, values, amplitude, condition)
             self._loads += 1
+        return condition
 
     def gravity(self, part: PartRef, acceleration, density: float | None = None, where: str | None = None,
-                amplitude=None) -> None:
+                amplitude=None) -> Condition:
         """Self-weight under the gravitational acceleration g (gdim numbers), a dead load scaled by
-        the load factor λ (or by ``amplitude(λ)``) like the other loads.
+        the load factor λ (or by ``amplitude(λ)``) like the other loads. Returns it as a
+        :class:`~dolfinx_corot.conditions.Condition` that construction stages may add or remove.
 
         density: mass per unit volume ρ; None: the density of the part's material
         (``dc.Elastic(E, nu, density=ρ)``).
@@ -278,8 +300,9 @@ class Scene:
             if not ok:
                 raise ValueError(f"{label}: density = {density!r} must be a finite number ≥ 0")
             density = float(density)
-        model.add_gravity(part, acc, density, where, amplitude)
+        condition = model.add_gravity(part, acc, density, where, amplitude, Condition("gravity", label[len("gravity "):]))
         self._loads += 1
+        return condition
 
     def contact(self, slaves: tuple[PartRef, str], masters: tuple[PartRef, str], law=None,
                 symmetric: bool = False, smooth: bool = True) -> list:

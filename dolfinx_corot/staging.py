@@ -1,8 +1,9 @@
 r"""Staged construction: a scene run as a sequence of stages, each with the elements that exist in it.
 
-A :class:`Stage` names the cell groups of solids and the groups of beams, bars and shell triangles that appear
-(``add``) or are excavated (``remove``) in it, on top of the stages before, and the driver that
-runs it (its own steps). :func:`solve_stages` runs the stages in turn on one configuration:
+A :class:`Stage` names the cell groups of solids and the groups of beams, bars, shells and membranes
+that appear (``add``) or are excavated (``remove``) in it, on top of the stages before, the
+supports, loads and contact interfaces it adds or removes, and the driver that runs it (its own
+steps). :func:`solve_stages` runs the stages in turn on one configuration:
 
 * **Existence.** An element that does not exist contributes nothing — no stiffness, no weight —
   and the nodes that no existing element touches are held where they are (a Dirichlet row each).
@@ -12,7 +13,13 @@ runs it (its own steps). :func:`solve_stages` runs the stages in turn on one con
   S_k = F_{k−1} + f_int,k(u₀) − f_int,k−1(u₀) (the parts' internal force at the configuration
   u₀ that ended the last stage, with this stage's existence and the last one's). A new layer's
   weight is applied over its stage; an excavated block's forces on the ground are released over
-  its stage (scaled from 1 to 0), not in one jump.
+  its stage (scaled from 1 to 0), not in one jump. On rows constrained in stage k − 1 and free
+  in stage k, S_k = f_int,k(u₀): a removed support's reaction is released over the stage.
+* **Supports, loads and interfaces** (:mod:`dolfinx_corot.conditions`): the handles that
+  ``Scene.fix``, ``prescribe``, ``load``, ``gravity`` and ``contact`` return are stage items. One
+  that the first stage naming it adds does not exist before it; the others exist from the start.
+  A support added holds its nodes where they are; a load added is applied over its stage, one
+  removed taken off over its stage; an interface removed releases its forces over the stage.
 * **Geostatic stage** (``reset_displacements``): at its end the displacements are discarded and
   the strains kept (each existing cell's shift s becomes s − u). Or K₀ initial stresses of level
   ground (``initial_stress=[K0(soil, k0, surface)]``): σ₀ carried at zero strain, in equilibrium
@@ -22,11 +29,11 @@ runs it (its own steps). :func:`solve_stages` runs the stages in turn on one con
   deformations): strains of u − s on the mesh, the original mesh being the reference. Approach
   II (large construction deformations): the reference of the new cell is the deformed position
   X + s, F = (I + ∇u)(I + ∇s)⁻¹. At small strain the two coincide.
-* **Structures** (beams and bars in 2D and 3D, shell triangles). Approach II: an element is added
-  undeformed in the configuration of that moment — the state of its nodes then (U_os, with the
-  rotations) is memorized per element, its reference is X + U_os and its deformation U − U_os
-  (in 3D the rotations since then, R R_osᵀ; a shell's frame and constants are those of X + U_os).
-  Approach I: the mesh is its reference and U its deformation.
+* **Structures** (beams and bars in 2D and 3D, shell triangles, quadrilateral membranes). Approach
+  II: an element is added undeformed in the configuration of that moment — the state of its nodes
+  then (U_os, with the rotations) is memorized per element, its reference is X + U_os and its
+  deformation U − U_os (in 3D the rotations since then, R R_osᵀ; a shell's or membrane's frame and
+  constants are those of X + U_os). Approach I: the mesh is its reference and U its deformation.
 
 * **Mapping of new continuum** (approach II, seed §3.1.2). Before new cells appear, the shift w of
   their nodes solves linear elasticity with the seed's artificial constants E = 1, ν = 0 on the
@@ -39,9 +46,11 @@ runs it (its own steps). :func:`solve_stages` runs the stages in turn on one con
   external boundary zero vertical shift. The nodes only new cells touch are moved to X + w, and
   the new cells take X + w as their stress-free reference (F = I at activation).
 * **Contact in stages.** A slave exists when an existing facet of its surface touches it, a
-  master segment when its element exists; pairs of non-existing ones are not searched. Approach
-  I: a slave that meets a master for the first time takes its gap (open or overlapping) as zero
-  (seed: the interface cancels the initial deformation of the bodies it joins).
+  master segment when its element exists; pairs of non-existing ones are not searched, nor those
+  of an interface that does not exist. Approach I: a slave that meets a master for the first
+  time takes its gap (open or overlapping) as zero (seed: the interface cancels the initial
+  deformation of the bodies it joins). Approach II keeps the gaps: the forces of an overlap
+  found by an interface that appears are in S_k and push the bodies apart over the stage.
 
 Reference: Z_Soil "Large deformations" report, §3.1.2 (the two approaches).
 """
@@ -54,6 +63,8 @@ import numpy as np
 from mpi4py import MPI
 
 from .assembly import make_system
+from .conditions import Condition
+from .contact.pair import ContactPair
 from .result import Result
 from .solvers import CheckpointError, ConvergenceError, CriticalPoint, LoadControl, solve
 from .solvers.run import read_checkpoint_on_all_ranks
@@ -66,9 +77,15 @@ class Stage:
     """One construction stage, run by ``driver`` (its load factor λ goes 0 → 1 from where the stage
     starts to its own loads).
 
-    add: [(solid part, cell group), …] appearing in it (strain-free, by the approach of the run);
-    remove: [(solid part, cell group), …] excavated in it — their forces on the remaining body are
-    released over the stage (scaled from 1 to 0 with λ), not in one jump;
+    add: what appears in it — (part, cell group) pairs of solids, beams, bars and shells (strain-free,
+    by the approach of the run); supports, prescribed motions and loads (the
+    :class:`~dolfinx_corot.conditions.Condition` that ``Scene.fix``, ``prescribe``, ``load`` and
+    ``gravity`` return: a support added holds its nodes where they are, a load is applied over
+    the stage); contact interfaces (the :class:`~dolfinx_corot.contact.ContactPair` of
+    ``Scene.contact``: approach I takes the gaps it finds as zero);
+    remove: what is excavated or taken away in it — cell groups, whose forces on the remaining body
+    are released over the stage (scaled from 1 to 0 with λ), not in one jump; supports, whose
+    reactions are released over the stage; loads and interfaces, whose forces are;
     reset_displacements: at its end the displacements are discarded and the strains (stresses)
     kept — a geostatic stage, after which displacements count from the initial state;
     initial_stress: [:class:`K0`, …] geostatic stresses of level ground given to solids at the
@@ -128,10 +145,37 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
     steps after a failure, see the drivers' ``run``), and reproduces the uninterrupted run."""
     if approach not in APPROACHES:
         raise ValueError(f"solve_stages: approach = {approach!r} is not one of {APPROACHES}")
+    models = scene.model.models if scene.model.coupled else [scene.model]
+    if scene.model.amplitudes:
+        raise ValueError("solve_stages: loads with an amplitude cannot be staged (each stage ramps its loads from "
+                         "where it starts to its own); add or remove the loads in the stages instead")
     staged = {}
+    initial, switched_on = _items(initial, "initial")
+    plan = [(st, *_items(st.add, f"stage '{st.name}' add"), *_items(st.remove, f"stage '{st.name}' remove"))
+            for st in stages]
     listed = [(item, "initial") for item in initial]
-    for st in stages:
-        listed += [(item, st.name) for item in list(st.add) + list(st.remove)]
+    for st, add, _, remove, _ in plan:
+        listed += [(item, st.name) for item in add + remove]
+    # a support, motion, load or interface exists from the start unless the first stage that names it
+    # adds it (and ``initial`` does not list it)
+    alive = {}
+    for _, _, on, _, off in plan:
+        for item in off + on:
+            if id(item) not in alive:
+                alive[id(item)] = any(item is other for other in switched_on) or not any(item is o for o in on)
+                item.exists = alive[id(item)]
+                if isinstance(item, Condition):
+                    item.holds = False
+    for stage, _, on, _, off in plan:  # each stage adds what does not exist and removes what does
+        for item in on:
+            if alive[id(item)]:
+                raise ValueError(f"solve_stages: stage '{stage.name}' adds {item!r}, which exists already")
+            alive[id(item)] = True
+        for item in off:
+            if not alive[id(item)]:
+                raise ValueError(f"solve_stages: stage '{stage.name}' removes {item!r}, which does not exist at "
+                                 "that stage")
+            alive[id(item)] = False
     for (ref, group), where in listed:
         model = ref.model
         if id(model) not in staged:
@@ -149,11 +193,15 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
     memorized = {}  # approach II: U_e of each staged solid after the last excavation stage
     loads = fint = None  # where the last stage ended: F_{k-1} and f_int,k-1(u₀) (owned entries)
     results = []
-    for index, stage in enumerate(stages):
+    constrained = None  # the rows the last stage's system constrained (global, all ranks)
+    for index, (stage, add, switch_on, remove, switch_off) in enumerate(plan):
         before = {key: exists.copy() for key, (_, exists) in staged.items()}
-        for ref, group in stage.add:
+        _switch(switch_on, switch_off)
+        for model in models:
+            model.stage = stage.name
+        for ref, group in add:
             staged[id(ref.model)][1][ref.model.tmesh.cells(group)] = True
-        for ref, group in stage.remove:
+        for ref, group in remove:
             cells = ref.model.tmesh.cells(group)
             if ref.model.comm.allreduce(not staged[id(ref.model)][1][cells].all(), op=MPI.LOR):
                 raise ValueError(f"solve_stages: stage '{stage.name}' removes '{group}' of {ref.kind} "
@@ -193,9 +241,17 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
                 system.start_stage(approach)
                 for itf, slaves in held_slaves:  # slaves of new cells that cannot move onto their master
                     itf.cancel_initial_gaps(slaves)
-                start = system.evaluate_internal_force()
+                force = system.evaluate_internal_force()
+                start = force.copy()
                 if loads is not None:
                     start += loads - fint
+                    # rows constrained before and free now (a support removed, nodes that a new
+                    # element touches) start loaded by the parts' force there: a removed support's
+                    # reaction, released over the stage
+                    start_row, stop_row = system.ownership_range()
+                    freed = np.setdiff1d(constrained, system.constrained_global_dofs())
+                    freed = freed[(freed >= start_row) & (freed < stop_row)] - start_row
+                    start[freed] = force[freed]
                 loads = system.ramp_loads_from(start)
             if stage.reset_displacements:
                 _check_resettable(system, staged, stage)
@@ -213,21 +269,48 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
             result.mappings = mappings
             results.append(result)
             fint = system.evaluate_internal_force()
-            # loads on constrained dofs act on nothing (a load on a node no element touches yet):
-            # the next stage applies them over its steps, from zero
+            # loads on constrained dofs act on nothing (a load on a node no element touches yet, or
+            # on a support): a stage that frees them starts from the parts' force there
             start_row, stop_row = system.ownership_range()
-            rows = system.constrained_global_dofs()
-            loads[rows[(rows >= start_row) & (rows < stop_row)] - start_row] = 0.0
+            constrained = system.constrained_global_dofs()
+            loads[constrained[(constrained >= start_row) & (constrained < stop_row)] - start_row] = 0.0
             if stage.reset_displacements:
                 for model, _ in staged.values():
                     model.reset_displacements()
-            if approach == "II" and stage.remove:
+            if approach == "II" and remove:
                 for key, (model, _) in staged.items():
                     if model.continuum:
                         memorized[key] = model.state.x.array.reshape(-1, model.gdim).copy()
         finally:
             system.destroy()
     return results
+
+
+def _items(items: Sequence, where: str) -> tuple[list, list]:
+    """The (part, cell group) pairs of a stage's list, and its supports, motions, loads and contact
+    interfaces."""
+    cells, switches = [], []
+    for item in items:
+        if isinstance(item, (Condition, ContactPair)):
+            switches.append(item)
+        elif isinstance(item, tuple) and len(item) == 2 and isinstance(item[1], str) and hasattr(item[0], "model"):
+            cells.append(item)
+        else:
+            raise TypeError(f"solve_stages: {where}: {item!r} is none of a (part, cell group) pair, a support, "
+                            "motion or load (what Scene.fix, prescribe, load and gravity return) or a contact "
+                            "interface (what Scene.contact returns)")
+    return cells, switches
+
+
+def _switch(on: list, off: list) -> None:
+    """The supports, motions, loads and interfaces that a stage adds (``on``) exist from now on — a
+    support added holds its nodes where they are — and those it removes (``off``) do not."""
+    for item in on:
+        item.exists = True
+        if isinstance(item, Condition) and item.kind == "support":
+            item.holds = True
+    for item in off:
+        item.exists = False
 
 
 class _StageFile:
@@ -379,7 +462,7 @@ def _map_new_continuum(scene, model, exists: np.ndarray, new: np.ndarray, memori
     slave = np.zeros(len(u), dtype=bool)
     held = []
     for itf in scene.interfaces:
-        if itf.slave_spec[0].model is not model:
+        if itf.slave_spec[0].model is not model or not itf.exists:
             continue
         surf = itf.slave
         shared = (in_new & ~new_only)[surf.blocks]
@@ -402,7 +485,7 @@ def _map_new_continuum(scene, model, exists: np.ndarray, new: np.ndarray, memori
     # seed §3.1.2: the mapping puts new nodes along an interface onto their master, so they must be
     # slaves; a new face that is only a master has nothing to tell where it lies
     for itf in scene.interfaces:
-        if itf.master_spec[0].model is not model:
+        if itf.master_spec[0].model is not model or not itf.exists:
             continue
         surf = itf.master
         masters = surf.blocks[new_only[surf.blocks] & ~slave[surf.blocks]]

@@ -153,22 +153,13 @@ def test_approach_one_at_large_strain_follows_the_uniaxial_law_layer_by_layer():
 
 
 def test_bad_stage_input_is_named():
-    """An unknown approach, a missing cell group and a part kind that cannot be staged yet
-    (quadrilateral membranes) each end in a clear error before anything is solved."""
+    """An unknown approach and a missing cell group each end in a clear error before anything is
+    solved."""
     sc, soil = _column_scene(2, large=False)
     with pytest.raises(ValueError, match=r"approach = 'III' is not one of \('I', 'II'\)"):
         solve_stages(sc, [Stage("one", add=[(soil, "layer1")])], approach="III")
     with pytest.raises(dc.GroupNotFoundError, match="'layer9' not found"):
         solve_stages(sc, [Stage("one", add=[(soil, "layer9")])])
-    from dolfinx_corot.io.mesh import from_arrays
-    sc2 = dc.Scene()
-    quads = from_arrays(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]),
-                        np.array([[0, 1, 2, 3]]), cell_name="sheet", comm=comm)
-    sheet = sc2.add_membrane(quads, "sheet", thickness=0.01, material=dc.Elastic(1.0e3))
-    with pytest.raises(NotImplementedError, match="solve_stages: membrane 'sheet': staged construction: "
-                                                  "MembraneQuad parts are not staged yet, only solids, beams, "
-                                                  "bars and shell triangles"):
-        solve_stages(sc2, [Stage("one", add=[(sheet, "sheet")])])
 
 
 @pytest.mark.skipif(comm.size > 1, reason="dense finite differences of the assembled system: serial")
@@ -273,7 +264,7 @@ def _by_position(points: np.ndarray, values: np.ndarray) -> dict:
 def _nodal(soil) -> dict:
     m = soil.model
     n = m.V.dofmap.index_map.size_local
-    return _by_position(m.V.tabulate_dof_coordinates()[:n, :2], m.state.x.array.reshape(-1, 2)[:n])
+    return _by_position(m.V.tabulate_dof_coordinates()[:n, :2], m.state.x.array.reshape(-1, m.state_size)[:n, :2])
 
 
 def _stresses(soil) -> dict:
@@ -835,26 +826,33 @@ def _staged_3d_scene(kind: str):
                            section=dc.Rectangle(0.2, 0.3), material=dc.Elastic(1.0e4), orientation=(0.0, 0.0, 1.0))
         sc.fix(part, "base")
         sc.load(part, "tip", force=(0.0, 0.0, -1.0))
-    else:
+    elif kind == "shell":
         points = np.array([[x, y, 0.1 * x * y] for y in (0.0, 0.5, 1.0) for x in (0.0, 0.5, 1.0)])
         cells = np.array([[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4], [3, 4, 7], [3, 7, 6], [4, 5, 8], [4, 8, 7]])
         tm = from_arrays(points, cells, cell_name="shell", point_groups={"edge": np.array([0, 3, 6])}, comm=comm)
         part = sc.add_shell(tm, "shell", thickness=0.05, material=dc.Elastic(2.0e4, 0.3))
         sc.fix(part, "edge")
+    else:  # quadrilateral membranes on a warped sheet
+        points = np.array([[x, y, 0.1 * x * y] for y in (0.0, 0.5, 1.0) for x in (0.0, 0.5, 1.0)])
+        cells = np.array([[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]])
+        tm = from_arrays(points, cells, cell_name="sheet", point_groups={"edge": np.array([0, 3, 6])}, comm=comm)
+        part = sc.add_membrane(tm, "sheet", thickness=0.01, material=dc.Elastic(2.0e4, 0.3))
+        sc.fix(part, "edge")
     return sc, part
 
 
 @pytest.mark.skipif(comm.size > 1, reason="dense finite differences of the assembled system: serial")
-@pytest.mark.parametrize("kind", ["beam", "shell"])
+@pytest.mark.parametrize("kind", ["beam", "shell", "membrane"])
 def test_staged_3d_tangent_matches_finite_differences(kind):
-    """3D beams and shell triangles added undeformed in a deformed configuration (approach II:
+    """3D beams, shell triangles and quadrilateral membranes added undeformed in a deformed configuration (approach II:
     reference X + u_a, states since then (u − u_a, R R_aᵀ), a the memorized states): added at
     random states (0.3 in translation, rotations up to 2 rad about any axis) they carry no
     internal force (1e-12); moved on from there (0.1, 0.3 rad), their tangent against central
     differences of the residual along translations and spins (R ← exp(h e) R), free dofs (1e-6)."""
     sc, part = _staged_3d_scene(kind)
-    solve_stages(sc, [Stage("place", add=[(part, part.name)])], approach="II")
     model = part.model
+    model.start_staging("II")  # every element exists (what a stage adding them does before its solve)
+    model.set_existing(np.ones(len(model.cells_existing()), dtype=bool))
     rng = np.random.default_rng(7)
     _random_states(model, rng, 0.3, 2.0)  # a large rigid-looking motion and some strain
     _memorize_current_states(model)
@@ -1018,3 +1016,277 @@ def test_k0_input_is_checked_by_name():
                        material=dc.Elastic(1.0e3))
     with pytest.raises(ValueError, match="K0 initial stress on beam 'beam': only solids carry initial stresses"):
         solve_stages(sc, [Stage("K0", add=[(beam, "beam")], initial_stress=[K0(beam, 0.5, 0.0)])])
+
+
+# -- supports, loads and interfaces as stage items ----------------------------------------------------------
+LC, P_TIP, Q_MID, Q_WEIGHT = 2.0, 0.3, 0.8, 0.25  # cantilever length; tip load, mid-span load, weight per length
+E_C, SEC = 2.0e4, dc.Rectangle(0.1, 0.2)
+EI_C = E_C * 0.1 * 0.2**3 / 12.0
+
+
+def _cantilever(items: bool = True, n: int = 8):
+    """A cantilever (clamped at x = 0, Bernoulli, section 0.1 × 0.2, geometrically linear) with a tip
+    load P_TIP that exists from the start, and (``items``) as stage items a prop at the tip (uy), a load
+    Q_MID at mid-span and its weight (Q_WEIGHT per length), all downwards; monitors at the tip and
+    mid-span, the reaction at the tip."""
+    x = np.linspace(0.0, LC, n + 1)
+    tm = dc.io.mesh.from_arrays(np.column_stack([x, 0.0 * x]), np.column_stack([np.arange(n), np.arange(1, n + 1)]),
+                                "beam", point_groups={"base": np.array([0]), "mid": np.array([n // 2]),
+                                                      "tip": np.array([n])}, comm=comm)
+    sc = dc.Scene(large_rotations=False, linear_solver="direct")
+    beam = sc.add_beam(tm, section=SEC, material=dc.Elastic(E_C, 0.3))
+    sc.fix(beam, "base")
+    sc.load(beam, "tip", force=(0.0, -P_TIP))
+    if items:
+        items = {"prop": sc.fix(beam, "tip", dofs=("uy",)),
+                 "mid load": sc.load(beam, "mid", force=(0.0, -Q_MID)),
+                 "weight": sc.gravity(beam, (0.0, -1.0), density=Q_WEIGHT / 0.02)}
+    sc.monitor("tip", beam, "tip")
+    sc.monitor("mid", beam, "mid")
+    sc.monitor_reaction("prop", beam, "tip")
+    return sc, beam, items
+
+
+def _cantilever_deflections(tip: float = 0.0, mid: float = 0.0, q: float = 0.0) -> np.ndarray:
+    """Downward deflections (at L/2, at L) of a cantilever of length LC under a tip force, a
+    mid-span force and a uniform load q (Euler–Bernoulli, e.g. Roark's Formulas for Stress and
+    Strain, table 8.1, cases 1a and 2a): w(x) = F x²(3a − x)/6EI for x ≤ a, F a²(3x − a)/6EI
+    beyond, and q x²(6L² − 4Lx + x²)/24EI."""
+    L, a = LC, LC / 2
+
+    def point(F, load_at, x):
+        return F * (x**2 * (3 * load_at - x) if x <= load_at else load_at**2 * (3 * x - load_at)) / (6 * EI_C)
+
+    return np.array([point(tip, L, x) + point(mid, a, x) + q * x**2 * (6 * L**2 - 4 * L * x + x**2) / (24 * EI_C)
+                     for x in (a, L)])
+
+
+def test_supports_and_loads_added_and_removed_by_stages_follow_the_closed_forms():
+    """A cantilever with its tip load P (geometrically linear; Bernoulli elements are nodally exact
+    under nodal forces and the work-equivalent loads of a uniform weight):
+    1. P alone: tip w₁ = PL³/3EI.
+    2. a prop is added at the tip and a load Q at mid-span: the prop holds the tip where it is
+       (not at zero) and the beam responds as a propped cantilever to Q: prop reaction 5Q/16,
+       mid-span w₁(L/2) + 7QL³/768EI — half of that increment halfway through the stage.
+    3. the beam's weight q is added: reaction 5Q/16 + 3qL/8.
+    4. the prop is removed: its reaction is released over the stage (halfway, half of it still
+       acts), and the beam ends as the cantilever under P, Q and q.
+    5. Q and the weight are removed: back to w₁ along the beam.
+    Every value to 1e-9 of the largest deflection (closed forms by superposition)."""
+    sc, beam, items = _cantilever()
+    stages = [Stage("P"),
+              Stage("prop and Q", add=[items["prop"], items["mid load"]], driver=dc.LoadControl(steps=2)),
+              Stage("weight", add=[items["weight"]]),
+              Stage("prop removed", remove=[items["prop"]], driver=dc.LoadControl(steps=2)),
+              Stage("Q and weight removed", remove=[items["mid load"], items["weight"]])]
+    results = solve_stages(sc, stages, approach="I")
+    rows = [r.history.rows for r in results]
+    w = lambda row: -np.array([row["mid_uy"], row["tip_uy"]])  # noqa: E731 (downward deflections)
+    L, q = LC, Q_WEIGHT
+    unit = _cantilever_deflections(tip=1.0)  # a unit upward prop force lifts the beam by this
+    w1 = _cantilever_deflections(tip=P_TIP)
+    r_q, r_w = 3 * EI_C * _cantilever_deflections(mid=Q_MID)[1] / L**3, 3 * q * L / 8  # propped reactions
+    assert r_q == pytest.approx(5 * Q_MID / 16, rel=1e-12)
+    with_q = w1 + _cantilever_deflections(mid=Q_MID) - r_q * unit
+    with_weight = with_q + _cantilever_deflections(q=q) - r_w * unit
+    free = _cantilever_deflections(tip=P_TIP, mid=Q_MID, q=q)
+    expected = [(rows[0][-1], w1), (rows[1][0], 0.5 * (w1 + with_q)), (rows[1][-1], with_q),
+                (rows[2][-1], with_weight), (rows[3][0], free - 0.5 * (r_q + r_w) * unit), (rows[3][-1], free),
+                (rows[4][-1], w1)]
+    scale = free.max()
+    for row, reference in expected:
+        assert np.abs(w(row) - reference).max() < 1e-9 * scale, (row["stage"] if "stage" in row else row, reference)
+    assert with_q[0] - w1[0] == pytest.approx(7 * Q_MID * L**3 / (768 * EI_C), rel=1e-12)  # (Roark 1e)
+    assert rows[1][-1]["prop_Fy"] == pytest.approx(5 * Q_MID / 16, rel=1e-9)
+    assert rows[2][-1]["prop_Fy"] == pytest.approx(5 * Q_MID / 16 + 3 * q * L / 8, rel=1e-9)
+    assert rows[3][-1]["prop_Fy"] == pytest.approx(0.0, abs=1e-9 * P_TIP)
+
+
+@pytest.mark.parametrize("kill", [("prop and Q", 1), ("prop removed", 1), ("Q and weight removed", 1)])
+def test_a_run_with_staged_supports_and_loads_restarts_exactly(tmp_path, kill):
+    """Killed in the stage that adds the prop and Q, in the one that removes the prop, or at the first
+    step of the last one: the restart sets the supports and loads of each stage as the stages say
+    (the prop holding the tip where the file has it), takes the stage's starting force from the file
+    and reproduces the uninterrupted run (1e-12)."""
+    sc, beam, items = _cantilever()
+
+    def stages(items):
+        return [Stage("P"), Stage("prop and Q", add=[items["prop"], items["mid load"]], driver=dc.LoadControl(steps=2)),
+                Stage("prop removed", remove=[items["prop"]], driver=dc.LoadControl(steps=2)),
+                Stage("Q and weight removed", remove=[items["mid load"], items["weight"]], driver=dc.LoadControl(steps=2))]
+
+    full = solve_stages(sc, stages(items))
+    path = comm.bcast(str(tmp_path / "staged.npz") if comm.rank == 0 else None, root=0)
+
+    def die(stage, row):
+        if (stage.name, row["step"]) == kill:
+            raise Killed
+
+    sc2, _, items2 = _cantilever()
+    with pytest.raises(Killed):
+        solve_stages(sc2, stages(items2), on_step=die, checkpoint=path)
+    sc3, _, items3 = _cantilever()
+    resumed = solve_stages(sc3, stages(items3), checkpoint=path, restart=path)
+    for a, b in zip(full, resumed):
+        for name in ("tip_uy", "mid_uy", "prop_Fy"):
+            np.testing.assert_allclose(b.history.column(name), a.history.column(name), rtol=0, atol=1e-12)
+
+
+def test_a_jack_removed_by_a_stage_releases_its_force():
+    """The cantilever with its tip load P, its tip pushed up by a jack (a prescribed motion that the
+    first stage adds: uy = JACK·λ); the next stage removes the jack: the beam ends as the cantilever
+    under P (w = PL³/3EI at the tip) and halfway through the stage the tip is midway (linear; 1e-9).
+    A jack's reaction while it acts: 3EI (JACK + w)/L³."""
+    sc, beam, _ = _cantilever(items=False)
+    jack = sc.prescribe(beam, "tip", uy=0.05)
+    results = solve_stages(sc, [Stage("jacked", add=[jack]),
+                                Stage("jack removed", remove=[jack], driver=dc.LoadControl(steps=2))])
+    w1 = _cantilever_deflections(tip=P_TIP)
+    jacked, midway, end = results[0].history.rows[-1], results[1].history.rows[0], results[1].history.rows[-1]
+    assert jacked["tip_uy"] == pytest.approx(0.05, rel=1e-12)
+    assert jacked["prop_Fy"] == pytest.approx(3 * EI_C * (0.05 + w1[1]) / LC**3, rel=1e-9)
+    assert abs(end["tip_uy"] + w1[1]) < 1e-9 * w1[1]
+    assert abs(end["mid_uy"] + w1[0]) < 1e-9 * w1[1]
+    assert abs(midway["tip_uy"] - 0.5 * (0.05 - w1[1])) < 1e-9 * w1[1]
+
+
+def test_bad_stage_items_are_named():
+    """Something that is not a stage item, a support added while it exists, a load removed while it
+    does not, and loads with an amplitude (each stage ramps its own loads) are refused by name,
+    before anything is solved."""
+    sc, beam, items = _cantilever()
+    solved = []
+    record = (lambda stage, row: solved.append(row))  # noqa: E731
+    with pytest.raises(TypeError, match="stage 'one' add: 'tip' is none of a \\(part, cell group\\) pair, a "
+                                        "support, motion or load"):
+        solve_stages(sc, [Stage("one", add=["tip"])])
+    with pytest.raises(ValueError, match="stage 'two' adds Condition\\(support on 'tip' of beam \\(uy\\)\\), "
+                                         "which exists already"):
+        solve_stages(sc, [Stage("one", add=[items["prop"]]), Stage("two", add=[items["prop"]])], on_step=record)
+    with pytest.raises(ValueError, match="stage 'two' removes Condition\\(load on 'mid' of beam\\), which does "
+                                         "not exist at that stage"):
+        solve_stages(sc, [Stage("one", remove=[items["mid load"]]), Stage("two", remove=[items["mid load"]])],
+                     on_step=record)
+    sc.load(beam, "mid", force=(0.0, -1.0), amplitude=dc.Amplitude([(0.0, 0.0), (1.0, 1.0)]))
+    with pytest.raises(ValueError, match="loads with an amplitude cannot be staged"):
+        solve_stages(sc, [Stage("one")], on_step=record)
+    assert not solved
+
+
+def _block_with_walls(large: bool, right_wall: bool = True):
+    """A soil block 4 × 2 (8 × 4 quadrilaterals) under its weight, clamped at its base, on rollers
+    along its left side and (``right_wall``) along its right one; its top takes a traction
+    (0.3, −1)·q as a stage item. Small strain, or SVK with q large enough for 5 % strains."""
+    from dolfinx_corot.io.mesh import rectangles
+
+    tm = rectangles({"soil": (0.0, 0.0, 4.0, 2.0, 8, 4)},
+                    {"base": [("soil", "bottom")], "left": [("soil", "left")], "right": [("soil", "right")],
+                     "top": [("soil", "top")]}, comm=comm)
+    sc = dc.Scene(large_rotations=large, linear_solver="direct")
+    material = dc.SaintVenantKirchhoff(E, NU, density=RHO) if large else dc.Elastic(E, NU, density=RHO)
+    soil = sc.add_solid(tm, material=material, degree=1)
+    sc.fix(soil, "base")
+    sc.fix(soil, "left", dofs=("ux",))
+    wall = sc.fix(soil, "right", dofs=("ux",)) if right_wall else None
+    sc.gravity(soil, (0.0, -G))
+    q = 400.0 if large else 40.0
+    surcharge = sc.load(soil, "top", traction=(0.3 * q, -q))
+    return sc, soil, wall, surcharge
+
+
+@pytest.mark.parametrize("large", [False, True])
+def test_a_surcharge_added_and_a_wall_removed_end_as_one_analysis_without_the_wall(large):
+    """A block under its weight, held by rollers on both sides; a stage adds a surcharge (pushing
+    towards the right wall too), the next removes the right wall over two steps. Elastic and
+    conservative loads: the end state is the equilibrium of the block without the wall under weight
+    and surcharge, whatever the path — node by node equal to one analysis of that block (1e-9 of
+    the largest displacement at small strain, 1e-8 with SVK at 5 % strain). Small strain: the
+    wall's reaction is released in proportion to λ, so halfway the block is midway between the
+    states that end the two stages (1e-9)."""
+    sc, soil, wall, surcharge = _block_with_walls(large)
+    states = {}
+    results = solve_stages(sc, [Stage("weight", driver=dc.LoadControl(steps=2)),
+                                Stage("surcharge", add=[surcharge], driver=dc.LoadControl(steps=2)),
+                                Stage("wall removed", remove=[wall], driver=dc.LoadControl(steps=2))],
+                           on_step=lambda stage, row: states.__setitem__((stage.name, row["load_factor"]),
+                                                                         _nodal(soil)))
+    assert all(r.history.column("cuts").sum() == 0 for r in results)
+    direct, direct_soil, _, _ = _block_with_walls(large, right_wall=False)
+    dc.solve(direct, dc.LoadControl(steps=4))
+    reference = _nodal(direct_soil)
+    scale = max(np.abs(u).max() for u in reference.values())
+    staged = states["wall removed", 1.0]
+    assert max(np.abs(staged[p] - u).max() for p, u in reference.items()) < (1e-8 if large else 1e-9) * scale
+    # the wall held the block: removing it moves the block by a good part of its displacement
+    before, midway = states["surcharge", 1.0], states["wall removed", 0.5]
+    assert max(np.abs(staged[p] - before[p]).max() for p in reference) > 0.1 * scale
+    if not large:
+        assert max(np.abs(midway[p] - 0.5 * (before[p] + staged[p])).max() for p in reference) < 1e-9 * scale
+
+
+F_BEAM = 0.05  # load at the middle of the beam on the soil block
+
+
+def _beam_on_block():
+    """A beam (span 3, section 1 × 0.2, E 1e4; pinned at both ends) lying on a soft soil block
+    (4 × 1, E 100) at zero gap, its nodes slaves of the block's top (penalty), a load F_BEAM at
+    mid-span; small strain."""
+    from dolfinx_corot.io.mesh import rectangles
+
+    block = rectangles({"soil": (0.0, -1.0, 4.0, 1.0, 16, 4)}, {"soil_base": [("soil", "bottom")],
+                                                                "soil_top": [("soil", "top")]}, comm=comm)
+    xb = np.linspace(0.5, 3.5, 13)
+    line = dc.io.mesh.from_arrays(np.column_stack([xb, np.full_like(xb, 0.1)]),
+                                  np.column_stack([np.arange(12), np.arange(1, 13)]), "beam",
+                                  point_groups={"left": np.array([0]), "right": np.array([12]),
+                                                "mid": np.array([6])}, comm=comm)
+    sc = dc.Scene(large_rotations=False, linear_solver="direct")
+    soil = sc.add_solid(block, material=dc.Elastic(100.0, 0.3), degree=1)
+    beam = sc.add_beam(line, section=dc.Rectangle(1.0, 0.2), material=dc.Elastic(1.0e4, 0.3))
+    sc.fix(soil, "soil_base")
+    sc.fix(beam, "left", dofs=("ux", "uy"))
+    sc.fix(beam, "right", dofs=("uy",))
+    sc.load(beam, "mid", force=(0.0, -F_BEAM))
+    sc.monitor("mid", beam, "mid")
+    pair = sc.contact(slaves=(beam, "beam"), masters=(soil, "soil_top"), law=dc.Penalty())
+    sc.monitor_contact("contact", pair)
+    return sc, soil, beam, pair
+
+
+@pytest.mark.parametrize("approach", ["I", "II"])
+def test_an_interface_removed_and_added_again_by_stages(approach):
+    """A beam pinned at its ends lies on a soft block and is pressed at mid-span: the contact
+    carries most of the load. A stage removes the interface: its forces are released over the
+    stage (halfway, the state is midway: small strain, 1e-9) and the beam ends as the simply
+    supported beam, w = FL³/48EI at mid-span (Roark table 8.1 case 1e; 1e-9), the block unloaded
+    back at zero. The next stage adds the interface again, the beam now deep in the block:
+    approach I takes every gap found as zero (seed §3.1.2), so nothing moves and the contact
+    carries nothing (1e-9); approach II keeps the gaps, the overlap's forces push the beam out
+    over the stage and it ends where the first stage ended (elastic, frictionless: one
+    equilibrium; 1e-9)."""
+    sc, soil, beam, pair = _beam_on_block()
+    states = {}
+
+    def record(stage, row):
+        states[stage.name, row["load_factor"]] = {**_nodal(soil), **_nodal(beam)}
+
+    results = solve_stages(sc, [Stage("loaded", driver=dc.LoadControl(steps=2)),
+                                Stage("interface removed", remove=[pair], driver=dc.LoadControl(steps=2)),
+                                Stage("interface added", add=[pair], driver=dc.LoadControl(steps=4))],
+                           approach=approach, on_step=record)
+    rows = [r.history.rows[-1] for r in results]
+    assert rows[0]["contact_Fy"] > 0.5 * F_BEAM  # (the force on the beam, upwards)
+    EI, span = 1.0e4 * 0.2**3 / 12, 3.0
+    w = F_BEAM * span**3 / (48 * EI)
+    assert rows[1]["mid_uy"] == pytest.approx(-w, rel=1e-9)
+    loaded, free = states["loaded", 1.0], states["interface removed", 1.0]
+    soil_nodes = _nodal(soil)
+    assert max(np.abs(free[p]).max() for p in soil_nodes) < 1e-9 * w
+    midway = states["interface removed", 0.5]
+    assert max(np.abs(midway[p] - 0.5 * (loaded[p] + free[p])).max() for p in free) < 1e-9 * w
+    end = states["interface added", 1.0]
+    if approach == "I":
+        assert max(np.abs(end[p] - free[p]).max() for p in free) < 1e-9 * w
+        assert abs(rows[2]["contact_Fy"]) < 1e-9 * F_BEAM
+    else:
+        assert max(np.abs(end[p] - loaded[p]).max() for p in free) < 1e-9 * w

@@ -132,6 +132,7 @@ class Interface:
         # staged construction: the slaves and master segments that exist (None: all), and the
         # initial gaps taken as zero (approach I, :meth:`cancel_initial_gaps`), added to the offsets
         self.slave_on = self.segment_on = None
+        self.exists = True  # (a stage may add or remove the interface)
         self.initial_gap = np.zeros(len(self.area))
         self.gap_cancelled = np.zeros(len(self.area), dtype=bool)
 
@@ -164,11 +165,13 @@ class Interface:
 
     def _update_existence(self) -> None:
         """Which slaves and master segments exist (staged construction): a slave exists when an
-        existing facet of its surface touches it, a segment when its element exists. The
-        multipliers of slaves that do not exist are reset."""
+        existing facet of its surface touches it, a segment when its element exists; none while
+        the interface itself does not exist. The multipliers of slaves that do not exist are reset."""
         slave, master = self.slave.existence(self.comm), self.master.existence(self.comm)
         self.slave_on = None if slave is None else slave[1]
         self.segment_on = None if master is None else master[0]
+        if not self.exists:
+            self.slave_on = np.zeros(len(self.area), dtype=bool)
         if self.slave_on is not None:
             self.multiplier[~self.slave_on] = 0.0
 

@@ -94,6 +94,19 @@ class ContactPair:
         self._chains = [_chains(surf.facets) if surf.two_sided else (surf.facets, np.zeros(len(surf.facets), int))
                         for surf in (first.slave, first.master)]
 
+    @property
+    def exists(self) -> bool:
+        """Whether the interface exists (staged construction: a stage may add or remove it)."""
+        return self.interfaces[0].exists
+
+    @exists.setter
+    def exists(self, value: bool) -> None:
+        for itf in self.interfaces:
+            itf.exists = bool(value)
+            if not value:  # an interface that appears again takes the gaps it then finds anew (approach I)
+                itf.initial_gap[:] = 0.0
+                itf.gap_cancelled[:] = False
+
     def __iter__(self):
         return iter(self.interfaces)
 

@@ -20,7 +20,7 @@ from ..corotation import frame_quad as frame
 from ..corotation.transform import linear_force, stiffness
 from ..elements import membrane_quad as law
 from .spatial import H, pack_constants, unpack_constants
-from .ufcx import tabulate_tensor_kernels
+from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
 NNODE = 4
 NDOF = 6 * NNODE
@@ -144,3 +144,22 @@ def _tabulate(w, c, X, f, K, tangent):
 
 
 vector_kernel, matrix_kernel = tabulate_tensor_kernels(_tabulate, NDOF, NCOEF, NNODE)
+
+
+@numba.njit(cache=True, inline="always")
+def _tabulate_staged(w, c, X, f, K, tangent):
+    """An element added undeformed when its nodes' states were A = w[NCOEF:] (staged construction,
+    approach II): reference X + u_A (its constants computed there), displacements u − u_A (the
+    rotations, which membranes do not use, are left out)."""
+    Xc = np.empty((4, 3))
+    u = np.empty((4, 3))
+    for a in range(4):
+        A = NCOEF + NSTATE * CCW[a]
+        for k in range(3):
+            Xc[a, k] = X[CCW[a], k] + w[A + k]
+            u[a, k] = w[NSTATE * CCW[a] + k] - w[A + k]
+    _evaluate_ccw(Xc, u, w[_E0:NCOEF], c[0] != 0.0, tangent, f, K)
+
+
+# (vector_kernel, matrix_kernel) of staged elements, compiled on first use
+staged_kernels = lazy_kernels(_tabulate_staged, NDOF, NCOEF + NNODE * NSTATE, NNODE)

@@ -24,6 +24,7 @@ import dolfinx.fem
 import dolfinx.la
 import dolfinx.mesh
 
+from ..conditions import Condition
 from ..io.mesh import TaggedMesh
 from .groups import NodeGroup, gather_group
 from .surface import Surface, SurfaceError
@@ -116,10 +117,11 @@ class Part:
     def _init_conditions(self) -> None:
         self.ndof = len(self.dof_names)
         self.parts: list[PartRef] = []
-        self._bcs: list[tuple[np.ndarray, tuple[int, ...]]] = []
-        self._prescribed: list[tuple[tuple[int, np.ndarray], int, Motion]] = []
+        # each support, motion and load with its Condition (whether it exists: staged construction)
+        self._bcs: list[tuple[np.ndarray, tuple[int, ...], Condition]] = []
+        self._prescribed: list[tuple[tuple[int, np.ndarray], int, Motion, Condition]] = []
         self._prescribed_values: list[tuple[dolfinx.fem.Function, np.ndarray, Motion]] = []
-        self._point_loads: list[tuple[np.ndarray, np.ndarray, object]] = []
+        self._point_loads: list[tuple[np.ndarray, np.ndarray, object, Condition]] = []
         self._mass: dict[tuple[str, str], tuple[float | None, float]] = {}
         self.lifting_bcs: list = []
         self._forms = None
@@ -150,34 +152,45 @@ class Part:
         self.reference = self.V.tabulate_dof_coordinates()[:, : self.gdim].copy()
 
     # -- supports, prescribed motion, loads ------------------------------------------
-    def fix(self, where: str, dofs: tuple[int, ...]) -> None:
-        self._bcs.append((self.dof_blocks(where), tuple(dofs)))
+    def fix(self, where: str, dofs: tuple[int, ...], condition: Condition | None = None) -> Condition:
+        """Support of dofs ``dofs`` at the nodes of ``where``: zero, or where they are when it appears
+        (a support a stage adds)."""
+        condition = condition or Condition("support", f"'{where}'")
+        self._bcs.append((self.dof_blocks(where), tuple(dofs), condition))
+        return condition
 
-    def prescribe(self, where: str, comp: int, value: float, amplitude=None, function=None) -> None:
+    def prescribe(self, where: str, comp: int, value: float, amplitude=None, function=None,
+                  condition: Condition | None = None) -> Condition:
         """Prescribed displacement of dof ``comp`` at the nodes of ``where``: ``value``·λ,
         ``value``·amplitude(λ), or ``function(λ, stage)``."""
-        self._prescribed.append((self._entities(where), comp, Motion(float(value), amplitude, function)))
+        condition = condition or Condition("motion", f"'{where}'")
+        self._prescribed.append((self._entities(where), comp, Motion(float(value), amplitude, function), condition))
+        return condition
 
-    def add_load(self, where: str, values: np.ndarray, amplitude=None) -> None:
+    def add_load(self, where: str, values: np.ndarray, amplitude=None, condition: Condition | None = None) -> Condition:
         """Dead nodal load at every node of group ``where``: λ·values, or amplitude(λ)·values."""
-        self._point_loads.append((self.dof_blocks(where), np.asarray(values, dtype=float)[: self.ndof], amplitude))
+        condition = condition or Condition("load", f"'{where}'")
+        self._point_loads.append((self.dof_blocks(where), np.asarray(values, dtype=float)[: self.ndof], amplitude,
+                                  condition))
+        return condition
 
-    def _load_amplitudes(self) -> list:
-        """Amplitudes of the part's loads (point loads here; distributed ones in subclasses)."""
-        return [amp for *_, amp in self._point_loads]
+    def load_conditions(self) -> list[tuple[object, Condition]]:
+        """[(amplitude, condition)] of the part's loads (point loads here; distributed ones in
+        subclasses)."""
+        return [(amp, cond) for *_, amp, cond in self._point_loads]
 
     @property
     def amplitudes(self) -> list:
         """The distinct amplitudes of the loads (None: proportional to λ)."""
         out = []
-        for amp in self._load_amplitudes():
+        for amp, _ in self.load_conditions():
             if amp is not None and amp not in out:
                 out.append(amp)
         return out
 
     @property
     def has_prescribed_motion(self) -> bool:
-        return any(motion.moves for *_, motion in self._prescribed)
+        return any(motion.moves for *_, motion, cond in self._prescribed if cond.exists)
 
     def set_load_factor(self, load_factor: float) -> None:
         """Set the prescribed displacements to their values at λ."""
@@ -188,7 +201,7 @@ class Part:
         """Take part in staged construction (:mod:`dolfinx_corot.staging`): existence per element
         from now on. Parts that cannot be staged yet say so."""
         raise NotImplementedError(f"staged construction: {type(self).__name__} parts are not staged yet, only "
-                                  "solids, beams, bars and shell triangles")
+                                  "solids, beams, bars, shells and membranes")
 
     def is_staged(self) -> bool:
         """Whether the part has existence per element (staged construction)."""
@@ -261,22 +274,38 @@ class Part:
         values at λ, see :meth:`set_load_factor`)."""
         zero = PETSc.ScalarType(0.0)
         bcs = []
-        for blocks, comps in self._bcs:
+        holding = []  # dofs of supports added by a stage
+        for blocks, comps, cond in self._bcs:
+            if not cond.exists:
+                continue
             for comp in comps:
-                bcs.append(dolfinx.fem.dirichletbc(zero, blocks * self.ndof + comp, self.V.sub(comp)))
+                if cond.holds:
+                    holding.append((blocks * self.ndof + comp, comp))
+                else:
+                    bcs.append(dolfinx.fem.dirichletbc(zero, blocks * self.ndof + comp, self.V.sub(comp)))
         free = self._fixed_blocks()
         for comp in range(self.translations, self.ndof):
             bcs.append(dolfinx.fem.dirichletbc(zero, free * self.ndof + comp, self.V.sub(comp)))
         held = self.held_blocks()
-        if self.comm.allreduce(len(held)):  # nodes of no existing element (staged construction): held where
-            # they are (the Function is made on every rank: its vector is collective)
+        if self.comm.allreduce(len(held)) or holding:  # nodes of no existing element (staged construction):
+            # held where they are (the Function is made on every rank: its vector is collective)
             here = dolfinx.fem.Function(self.V)
             with self.displacement_vector().localForm() as x:
                 here.x.array[:] = x.array
-            bcs.append(dolfinx.fem.dirichletbc(here, np.sort(held).astype(np.int32)))
+            if self.comm.allreduce(len(held)):
+                bcs.append(dolfinx.fem.dirichletbc(here, np.sort(held).astype(np.int32)))
+            for dofs, comp in holding:  # supports added by a stage: where their nodes are
+                Vi, parent = self.V.sub(comp).collapse()
+                inside = np.full(len(here.x.array), -1, dtype=np.int32)
+                inside[np.asarray(parent)] = np.arange(len(parent), dtype=np.int32)
+                g = dolfinx.fem.Function(Vi)
+                g.x.array[inside[dofs]] = here.x.array[dofs]
+                bcs.append(dolfinx.fem.dirichletbc(g, [dofs.astype(np.int32), inside[dofs]], self.V.sub(comp)))
         self._prescribed_values = []
         self.lifting_bcs = []
-        for entities, comp, motion in self._prescribed:
+        for entities, comp, motion, cond in self._prescribed:
+            if not cond.exists:
+                continue
             Vi, _ = self.V.sub(comp).collapse()
             g = dolfinx.fem.Function(Vi)
             dofs = dolfinx.fem.locate_dofs_topological((self.V.sub(comp), Vi), *entities)
@@ -289,8 +318,11 @@ class Part:
     def constraint_dofs(self) -> list[tuple[np.ndarray, float, object]]:
         """[(local unrolled dofs of V, value, amplitude)]: supports (value 0) and prescribed motion
         (value·λ or value·amplitude(λ); a general motion as value 1 and amplitude λ ↦ motion(λ))."""
-        out = [(blocks * self.ndof + comp, 0.0, None) for blocks, comps in self._bcs for comp in comps]
-        for entities, comp, motion in self._prescribed:
+        out = [(blocks * self.ndof + comp, None if cond.holds else 0.0, None)
+               for blocks, comps, cond in self._bcs if cond.exists for comp in comps]
+        for entities, comp, motion, cond in self._prescribed:
+            if not cond.exists:
+                continue
             blocks = dolfinx.fem.locate_dofs_topological(self.V, *entities)
             if motion.function is None:
                 out.append((blocks * self.ndof + comp, motion.value, motion.amplitude))
@@ -306,8 +338,8 @@ class Part:
         held = self.held_blocks() if self.is_staged() and self._point_loads else np.zeros(0, dtype=np.int32)
         with b.localForm() as bl:
             arr = bl.array.reshape(-1, self.ndof)
-            for blocks, values, amp in self._point_loads:
-                if amp is amplitude:
+            for blocks, values, amp, cond in self._point_loads:
+                if amp is amplitude and cond.exists:
                     blocks = blocks[(blocks < n_owned) & ~np.isin(blocks, held)]
                     arr[blocks, : len(values)] += values
 
@@ -582,7 +614,7 @@ class Part:
         self._refuse_kind("membrane", where, "membranes need a triangle or quadrilateral mesh in 3D "
                           "(from_gmsh(model, gdim=3))")
 
-    def add_traction(self, where: str, traction: np.ndarray, amplitude=None) -> None:
+    def add_traction(self, where: str, traction: np.ndarray, amplitude=None, condition=None) -> Condition:
         raise ValueError(f"load '{where}': tractions act on solids; structures take forces and moments")
 
     def set_mass(self, part: PartRef, density: float | None, measure: float) -> None:
@@ -592,7 +624,7 @@ class Part:
         self._mass[(part.kind, part.name)] = (density, float(measure))
 
     def add_gravity(self, part: PartRef, acceleration: np.ndarray, density: float | None, where: str | None,
-                    amplitude=None) -> None:
+                    amplitude=None, condition: Condition | None = None) -> Condition:
         """Self-weight of ``part`` under the gravitational acceleration g (gdim,), dead and scaled
         like the other loads; ``density`` None: the material's."""
         raise NotImplementedError(f"gravity on {part.kind} '{part.name}': not available for {self.kind_name} parts")

@@ -22,6 +22,7 @@ import dolfinx.fem
 import dolfinx.la
 
 from .. import _dolfinx, rotations
+from ..conditions import Condition
 from ..elements import beam3d as law3d
 from ..elements import line2d as law2d
 from ..elements import uniform_load
@@ -63,7 +64,7 @@ class LineFrame(Part):
         self._owner_of_cell = np.full(cmap.size_local + cmap.num_ghosts, "", dtype=object)
         self._bending = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
         self._element_props: list[tuple[str, list[float]]] = []
-        self._gravity: list[tuple[str, str | None, np.ndarray, object]] = []
+        self._gravity: list[tuple[str, str | None, np.ndarray, object, Condition]] = []
         self._init_conditions()
 
     # -- building -----------------------------------------------------------
@@ -151,7 +152,7 @@ class LineFrame(Part):
         return cells
 
     def add_gravity(self, part: PartRef, acceleration: np.ndarray, density: float | None, where: str | None,
-                    amplitude=None) -> None:
+                    amplitude=None, condition: Condition | None = None) -> Condition:
         """Self-weight ρ·A·g per unit reference length of beams and bars, ρ·t·g per unit reference
         area of shells and membranes, of the elements of ``part`` (within group ``where`` if given),
         as dead work-equivalent nodal loads (:mod:`dolfinx_corot.elements.uniform_load`)."""
@@ -166,15 +167,17 @@ class LineFrame(Part):
         if where is not None and not self.comm.allreduce(len(self._weight_cells(label, where))):
             raise ValueError(f"gravity on {label}: group '{where}' holds none of its elements")
         q = float(density) * measure * np.asarray(acceleration, dtype=float)
-        self._gravity.append((label, where, q, amplitude))
+        condition = condition or Condition("gravity", f"on {label}")
+        self._gravity.append((label, where, q, amplitude, condition))
+        return condition
 
-    def _load_amplitudes(self) -> list:
-        return [amp for *_, amp in self._point_loads + self._gravity]
+    def load_conditions(self) -> list:
+        return [(amp, cond) for *_, amp, cond in self._point_loads + self._gravity]
 
     def _add_distributed_loads(self, b: PETSc.Vec, amplitude) -> None:
         """Add the self-weight loads of one amplitude (None: proportional to λ) at unit factor,
         from the reference positions of the nodes."""
-        terms = [(label, where, q) for label, where, q, amp in self._gravity if amp is amplitude]
+        terms = [(label, where, q) for label, where, q, amp, cond in self._gravity if amp is amplitude and cond.exists]
         if not terms:
             return
         g = self.gdim
@@ -243,7 +246,7 @@ class LineFrame(Part):
         deformations, or nodes at rest until then)."""
         if not hasattr(self.kernels, "staged_kernels"):
             raise NotImplementedError(f"staged construction: {type(self).__name__} parts are not staged yet, only "
-                                      "solids, beams, bars and shell triangles")
+                                      "solids, beams, bars, shells and membranes")
         if self._existing is None:
             self._existing = np.zeros(len(self._owner_of_cell), dtype=bool)
             Q = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("DG", 0),
@@ -452,11 +455,12 @@ class Rotations3D:
         st = self.state.x.array.reshape(-1, kernels3d.NSTATE)
         return rotations.rotvecs_from_quats(np.ascontiguousarray(st[:, 3:7]))
 
-    def prescribe(self, where: str, comp: int, value: float, amplitude=None, function=None) -> None:
+    def prescribe(self, where: str, comp: int, value: float, amplitude=None, function=None,
+                  condition: Condition | None = None) -> Condition:
         if comp >= self.translations and (value != 0.0 or function is not None):
             raise NotImplementedError(f"prescribe '{where}': non-zero rotations ({self.dof_names[comp]}) "
                                       "cannot be prescribed in 3D; prescribe displacements or apply a moment")
-        Part.prescribe(self, where, comp, value, amplitude, function)
+        return Part.prescribe(self, where, comp, value, amplitude, function, condition)
 
 
 class Frame3D(Rotations3D, LineFrame):

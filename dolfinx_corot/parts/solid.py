@@ -38,6 +38,7 @@ import dolfinx.la
 
 from .. import validate
 from ..assembly import petsc
+from ..conditions import Condition
 from ..continuum.kinematics import deformation_gradient
 from ..continuum.laws import first_piola, lame
 from ..io.mesh import TaggedMesh
@@ -95,8 +96,9 @@ class Solid(AdditiveState, Part):
         self._has_density = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
         self.law: type | None = None
         self._regions: list[tuple[str, str, float, float]] = []
-        self._tractions: list[tuple[str, np.ndarray, object]] = []
-        self._body: list[tuple[str | None, np.ndarray, bool, object]] = []  # (where, b, × material ρ, amplitude)
+        self._tractions: list[tuple[str, np.ndarray, object, Condition]] = []
+        # (where, b, × material ρ, amplitude, condition)
+        self._body: list[tuple[str | None, np.ndarray, bool, object, Condition]] = []
         self._init_conditions()
         self._shifted = False
         # staged construction (dolfinx_corot.staging): which cells exist (DG0, 1/0), the shift s of
@@ -155,28 +157,34 @@ class Solid(AdditiveState, Part):
                              "boundary dofs by facets; read the mesh with from_gmsh")
         return 0, self.tmesh.vertices(where)
 
-    def add_traction(self, where: str, traction: np.ndarray, amplitude=None) -> None:
+    def add_traction(self, where: str, traction: np.ndarray, amplitude=None,
+                     condition: Condition | None = None) -> Condition:
         if self.tmesh.facets(where) is None:
             raise ValueError(f"traction on '{where}': a group of facets (dimension {self.tdim - 1}) read with "
                              "from_gmsh is needed")
-        self._tractions.append((where, np.asarray(traction, dtype=float), amplitude))
+        condition = condition or Condition("load", f"'{where}'")
+        self._tractions.append((where, np.asarray(traction, dtype=float), amplitude, condition))
+        return condition
 
     def add_body_force(self, where: str | None, force: np.ndarray, amplitude=None,
-                       material_density: bool = False) -> None:
+                       material_density: bool = False, condition: Condition | None = None) -> Condition:
         """Body force per unit reference volume on the cells of ``where`` (all if None): ``force``,
         or ρ·``force`` with the density ρ of each cell's material (``material_density``)."""
         if where is not None:
             self.tmesh.cells(where)  # fails early for a missing group
-        self._body.append((where, np.asarray(force, dtype=float), bool(material_density), amplitude))
+        condition = condition or Condition("load", f"body force on '{where or 'all cells'}'")
+        self._body.append((where, np.asarray(force, dtype=float), bool(material_density), amplitude, condition))
         if material_density:
             self._check_density(where)
+        return condition
 
     def add_gravity(self, part: PartRef, acceleration: np.ndarray, density: float | None, where: str | None,
-                    amplitude=None) -> None:
+                    amplitude=None, condition: Condition | None = None) -> Condition:
         """Body force ρ·g per unit reference volume on the cells of ``where`` (all cells of the
         mesh if None, whatever region ``part`` names); ``density`` None: each cell's material's."""
-        self.add_body_force(where, acceleration if density is None else density * acceleration, amplitude,
-                            material_density=density is None)
+        condition = condition or Condition("gravity", f"on '{where or 'all cells'}'")
+        return self.add_body_force(where, acceleration if density is None else density * acceleration, amplitude,
+                                   material_density=density is None, condition=condition)
 
     def _check_density(self, where: str | None) -> None:
         """Every cell of ``where`` (all if None) has a material with a density (checked on all ranks)."""
@@ -190,8 +198,8 @@ class Solid(AdditiveState, Part):
                              " has no density; give its material one (dc.SaintVenantKirchhoff(E, nu, density=ρ)) "
                              "or pass density= to scene.gravity")
 
-    def _load_amplitudes(self) -> list:
-        return [amp for *_, amp in self._tractions + self._body + self._point_loads]
+    def load_conditions(self) -> list:
+        return [(amp, cond) for *_, amp, cond in self._tractions + self._body + self._point_loads]
 
     # -- initial (K₀) stress ---------------------------------------------------------------
     initial_stress = None  # σ₀ (UFL) the cells carry at zero strain, or None
@@ -225,7 +233,7 @@ class Solid(AdditiveState, Part):
         n = self.tmesh.mesh.topology.index_map(self.tdim).size_local
         rho = self.density.x.array[self._cell_dof[:n]]
         values = np.unique(np.concatenate(self.comm.allgather(rho)))
-        gravity = [b for _, b, by_density, _ in self._body if by_density]
+        gravity = [b for _, b, by_density, _, cond in self._body if by_density and cond.exists]
         if len(values) != 1 or values[0] <= 0.0 or len(gravity) != 1:
             raise ValueError(f"{label}: give unit_weight= (the solid has {len(values)} densities "
                              f"{values[:3].tolist()} and {len(gravity)} gravity load(s); the unit weight is taken "
@@ -518,18 +526,18 @@ class Solid(AdditiveState, Part):
             area = ufl.sqrt(ufl.dot(ufl.dot(ufl.inv(J0).T, ufl.FacetNormal(self.V.mesh)),
                                     ufl.dot(ufl.inv(J0).T, ufl.FacetNormal(self.V.mesh)))) * volume
         terms = []
-        if any(a is amplitude for *_, a in self._tractions):
+        if any(a is amplitude and cond.exists for *_, a, cond in self._tractions):
             ds = ufl.Measure("ds", domain=self.V.mesh, subdomain_data=self.tmesh.facet_tags)
-            for where, t, amp in self._tractions:
-                if amp is amplitude:
+            for where, t, amp, cond in self._tractions:
+                if amp is amplitude and cond.exists:
                     tag = self.tmesh.groups[where][1]
                     term = ufl.inner(ufl.as_vector([float(c) for c in t]), v)
                     if self.existing is not None:  # on the faces of existing cells
                         term = self.existing * term
                     terms.append((term if area is None else area * term) * ds(tag))
         dx = ufl.Measure("dx", domain=self.V.mesh, subdomain_data=self.tmesh.cell_tags)
-        for where, b, material_density, amp in self._body:
-            if amp is amplitude:
+        for where, b, material_density, amp, cond in self._body:
+            if amp is amplitude and cond.exists:
                 measure = dx if where is None else dx(self.tmesh.groups[where][1])
                 term = ufl.inner(ufl.as_vector([float(c) for c in b]), v)
                 if material_density:

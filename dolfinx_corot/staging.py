@@ -283,6 +283,8 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
                         memorized[key] = model.state.x.array.reshape(-1, model.gdim).copy()
         finally:
             system.destroy()
+    for model in models:
+        model.stage = None
     return results
 
 

@@ -1134,13 +1134,20 @@ def test_a_run_with_staged_supports_and_loads_restarts_exactly(tmp_path, kill):
 
 def test_a_jack_removed_by_a_stage_releases_its_force():
     """The cantilever with its tip load P, its tip pushed up by a jack (a prescribed motion that the
-    first stage adds: uy = JACK·λ); the next stage removes the jack: the beam ends as the cantilever
-    under P (w = PL³/3EI at the tip) and halfway through the stage the tip is midway (linear; 1e-9).
-    A jack's reaction while it acts: 3EI (JACK + w)/L³."""
+    first stage adds: uy(λ, stage) = 0.05 λ, told the stage's name); the next stage removes the jack:
+    the beam ends as the cantilever under P (w = PL³/3EI at the tip) and halfway through the stage
+    the tip is midway (linear; 1e-9). The jack's reaction while it acts: 3EI (0.05 + w)/L³."""
     sc, beam, _ = _cantilever(items=False)
-    jack = sc.prescribe(beam, "tip", uy=0.05)
+    stages_seen = set()
+
+    def lift(lam, stage):
+        stages_seen.add(stage)
+        return 0.05 * lam
+
+    jack = sc.prescribe(beam, "tip", uy=lift)
     results = solve_stages(sc, [Stage("jacked", add=[jack]),
                                 Stage("jack removed", remove=[jack], driver=dc.LoadControl(steps=2))])
+    assert stages_seen == {"jacked"}
     w1 = _cantilever_deflections(tip=P_TIP)
     jacked, midway, end = results[0].history.rows[-1], results[1].history.rows[0], results[1].history.rows[-1]
     assert jacked["tip_uy"] == pytest.approx(0.05, rel=1e-12)

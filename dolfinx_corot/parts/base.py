@@ -316,8 +316,9 @@ class Part:
         return bcs
 
     def constraint_dofs(self) -> list[tuple[np.ndarray, float, object]]:
-        """[(local unrolled dofs of V, value, amplitude)]: supports (value 0) and prescribed motion
-        (value·λ or value·amplitude(λ); a general motion as value 1 and amplitude λ ↦ motion(λ))."""
+        """[(local unrolled dofs of V, value, amplitude)] of the existing supports (value 0; None: held
+        where they are, a support a stage added) and prescribed motion (value·λ or
+        value·amplitude(λ); a general motion as value 1 and amplitude λ ↦ motion(λ))."""
         out = [(blocks * self.ndof + comp, None if cond.holds else 0.0, None)
                for blocks, comps, cond in self._bcs if cond.exists for comp in comps]
         for entities, comp, motion, cond in self._prescribed:

@@ -1,0 +1,364 @@
+r"""Node-to-face contact kernels in 3D: a slave node against a triangle or a bilinear quadrilateral.
+
+A pair is the slave x_s and the face's nodes x_1 … x_k (k = 3 or 4, counter-clockwise seen from
+outside the master body, so that the face normal points out of it), stored as x (1 + k, 3); the
+pair's dofs are the slave's translations then the face nodes'. The contact point x_c is the
+closest point to the slave
+
+* on the face (``mode`` 0): x_c = Σ N_a(ξ) x_a with ξ = (ξ, η) solving (x_s − x_c)·∂x_c/∂ξ_i = 0
+  (one Newton step for triangles, a few for the bilinear quadrilateral), n the unit normal
+  x_{,ξ} × x_{,η} / |·| there;
+* on the edge e from local node e to e + 1 (``mode`` 1, where the slave is beyond a convex edge):
+  x_c = (1 − t) x_a + t x_b, n = ±(x_s − x_c)/|x_s − x_c|;
+* at the vertex v (``mode`` 2): x_c = x_v, n = ±(x_s − x_v)/|x_s − x_v|,
+
+the sign making n point out of the master (the side of the face normal at the face's centre).
+Gap g = (x_s − x_c)·n − offset (offset: a shell's half thickness, a beam's half depth); pressure
+p = ⟨λ − ε g⟩ (penalty ε; λ the augmented-Lagrangian multiplier, 0 for pure penalty); with the
+slave's tributary area A the pair's energy is W = A ⟨λ − ε g⟩²/(2ε) and its internal force
+f = ∂W/∂x = −A p ∂g/∂x, with ∂g/∂x_s = n and ∂g/∂x_a = −N_a n (the closest point's parametric
+derivatives drop out at the projection). The tangent K = ∂f/∂x is computed by complex-step
+differentiation of f (Squire & Trapp 1998; h = 1e-30: exact to round-off), each column one
+complex evaluation of the projection and the force — consistent by construction, symmetric
+(the Hessian of W).
+
+References: P. Wriggers, *Computational Contact Mechanics*, 2nd ed., Springer 2006, §4.1 and
+§9.1 (3D node-to-surface contact, closest-point projection, edge and vertex contact);
+T. A. Laursen, *Computational Contact and Impact Mechanics*, Springer 2002, ch. 5; W. Squire and
+G. Trapp, SIAM Review 40 (1998) 110–112.
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+H = 1e-30  # complex step
+NMAX = 4   # nodes of a face at most
+PAIR_DOFS = 3 * (1 + NMAX)
+QUAD_XI = np.array([-1.0, 1.0, 1.0, -1.0])
+QUAD_ETA = np.array([-1.0, -1.0, 1.0, 1.0])
+_NEWTON_ITERATIONS = 30
+
+
+@numba.njit(cache=True)
+def shape(k, xi, eta, N, dN):
+    """Shape functions N (k,) and their derivatives dN (k, 2) at (ξ, η): the linear triangle on
+    the unit triangle (k = 3), the bilinear quadrilateral on [−1, 1]² (k = 4)."""
+    if k == 3:
+        N[0] = 1.0 - xi - eta
+        N[1] = xi
+        N[2] = eta
+        dN[0, 0] = -1.0
+        dN[0, 1] = -1.0
+        dN[1, 0] = 1.0
+        dN[1, 1] = 0.0
+        dN[2, 0] = 0.0
+        dN[2, 1] = 1.0
+    else:
+        for a in range(4):
+            N[a] = 0.25 * (1.0 + QUAD_XI[a] * xi) * (1.0 + QUAD_ETA[a] * eta)
+            dN[a, 0] = 0.25 * QUAD_XI[a] * (1.0 + QUAD_ETA[a] * eta)
+            dN[a, 1] = 0.25 * QUAD_ETA[a] * (1.0 + QUAD_XI[a] * xi)
+
+
+@numba.njit(cache=True)
+def _cross(a, b, out):
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@numba.njit(cache=True)
+def project(x, k):
+    """(ξ, η) of the closest point of the (unbounded) face surface to the slave: Newton on
+    (x_s − x_c)·x_{c,ξi} = 0 from the face's centre (Gauss–Newton where the Hessian of the
+    distance is not positive, far from a warped face; steps at most the face's size); works in
+    the dtype of x (complex for the complex step). Returns (ξ, η, converged)."""
+    dt = x.dtype
+    zero = x[0, 0] * 0.0
+    # coordinates from the face's first node: round-off at the scale of the face, not of the model
+    y = np.empty((1 + k, 3), dtype=dt)
+    for a in range(1 + k):
+        for d in range(3):
+            y[a, d] = x[a, d] - x[1, d]
+    x = y
+    xi = (zero + 1.0 / 3.0) if k == 3 else zero
+    eta = xi
+    N = np.empty(k, dtype=dt)
+    dN = np.empty((k, 2), dtype=dt)
+    xc = np.empty(3, dtype=dt)
+    t1 = np.empty(3, dtype=dt)
+    t2 = np.empty(3, dtype=dt)
+    t12 = np.empty(3, dtype=dt)
+    done = 0
+    for it in range(_NEWTON_ITERATIONS):
+        shape(k, xi, eta, N, dN)
+        for d in range(3):
+            xc[d] = 0.0
+            t1[d] = 0.0
+            t2[d] = 0.0
+            t12[d] = 0.0
+        for a in range(k):
+            for d in range(3):
+                xc[d] += N[a] * x[1 + a, d]
+                t1[d] += dN[a, 0] * x[1 + a, d]
+                t2[d] += dN[a, 1] * x[1 + a, d]
+                if k == 4:
+                    t12[d] += 0.25 * QUAD_XI[a] * QUAD_ETA[a] * x[1 + a, d]
+        r1 = zero
+        r2 = zero
+        a11 = zero
+        a12 = zero
+        a22 = zero
+        e12 = zero  # the curvature term of the Hessian (bilinear faces)
+        for d in range(3):
+            e = x[0, d] - xc[d]
+            r1 += e * t1[d]
+            r2 += e * t2[d]
+            a11 += t1[d] * t1[d]
+            a22 += t2[d] * t2[d]
+            a12 += t1[d] * t2[d] - e * t12[d]
+            e12 += e * t12[d]
+        det = a11 * a22 - a12 * a12
+        if not (det.real > 1e-14 * (a11.real * a22.real)):  # far from a warped face: Gauss–Newton
+            a12 = a12 + e12
+            det = a11 * a22 - a12 * a12
+            if not det.real > 0.0:
+                return xi, eta, False
+        dxi = (a22 * r1 - a12 * r2) / det
+        deta = (a11 * r2 - a12 * r1) / det
+        step = abs(dxi.real) + abs(deta.real)
+        if step > 1.0:  # no more than the face's size per iteration
+            dxi /= step
+            deta /= step
+        xi += dxi
+        eta += deta
+        if abs(dxi.real) + abs(deta.real) < 1e-13:
+            done += 1
+            if done >= 2 or k == 3:  # two more for the complex step's imaginary part
+                return xi, eta, True
+    return xi, eta, False
+
+
+@numba.njit(cache=True)
+def inside(k, xi, eta, tol):
+    """Whether (ξ, η) lies on the face, within ``tol`` (in its parameter) beyond its edges."""
+    if k == 3:
+        return xi >= -tol and eta >= -tol and xi + eta <= 1.0 + tol
+    return abs(xi) <= 1.0 + tol and abs(eta) <= 1.0 + tol
+
+
+@numba.njit(cache=True)
+def _contact_point(x, k, mode, which, N, n):
+    """The contact point's weights N (k,) on the face nodes and the unit normal n (3,) out of the
+    master, for ``mode`` 0 (face), 1 (edge ``which``) or 2 (vertex ``which``); returns the distance
+    (x_s − x_c)·n."""
+    dt = x.dtype
+    zero = x[0, 0] * 0.0
+    dN = np.empty((k, 2), dtype=dt)
+    t1 = np.zeros(3, dtype=dt)
+    t2 = np.zeros(3, dtype=dt)
+    # the face normal at its centre: the master's outside
+    shape(k, (zero + 1.0 / 3.0) if k == 3 else zero, (zero + 1.0 / 3.0) if k == 3 else zero, N, dN)
+    for a in range(k):
+        for d in range(3):
+            t1[d] += dN[a, 0] * x[1 + a, d]
+            t2[d] += dN[a, 1] * x[1 + a, d]
+    nc = np.empty(3, dtype=dt)
+    _cross(t1, t2, nc)
+    for a in range(k):
+        N[a] = 0.0
+    if mode == 0:
+        xi, eta, _ = project(x, k)
+        shape(k, xi, eta, N, dN)
+        for d in range(3):
+            t1[d] = 0.0
+            t2[d] = 0.0
+        for a in range(k):
+            for d in range(3):
+                t1[d] += dN[a, 0] * x[1 + a, d]
+                t2[d] += dN[a, 1] * x[1 + a, d]
+        _cross(t1, t2, n)
+        norm = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
+        for d in range(3):
+            n[d] /= norm
+    else:
+        if mode == 1:
+            a = which
+            b = (which + 1) % k
+            num = zero
+            den = zero
+            for d in range(3):
+                e = x[1 + b, d] - x[1 + a, d]
+                num += (x[0, d] - x[1 + a, d]) * e
+                den += e * e
+            t = num / den
+            N[a] = 1.0 - t
+            N[b] = t
+        else:
+            N[which] = 1.0
+        norm2 = zero
+        side = 0.0
+        for d in range(3):
+            xc = zero
+            for a in range(k):
+                xc += N[a] * x[1 + a, d]
+            n[d] = x[0, d] - xc
+            norm2 += n[d] * n[d]
+            side += (n[d] * nc[d]).real
+        norm = np.sqrt(norm2)
+        sign = 1.0 if side >= 0.0 else -1.0
+        for d in range(3):
+            n[d] = sign * n[d] / norm
+    dist = zero
+    for d in range(3):
+        xc = zero
+        for a in range(k):
+            xc += N[a] * x[1 + a, d]
+        dist += (x[0, d] - xc) * n[d]
+    return dist
+
+
+@numba.njit(cache=True)
+def _force(x, k, mode, which, offset, lam, eps, area, f):
+    """Gap and internal force f (3 (1 + k),) of one pair (see the module's docstring)."""
+    dt = x.dtype
+    zero = x[0, 0] * 0.0
+    N = np.empty(k, dtype=dt)
+    n = np.empty(3, dtype=dt)
+    g = _contact_point(x, k, mode, which, N, n) - offset
+    p = lam - eps * g
+    if p.real <= 0.0:
+        p = zero
+    for d in range(3):
+        f[d] = -area * p * n[d]
+        for a in range(k):
+            f[3 + 3 * a + d] = area * p * N[a] * n[d]
+    return g
+
+
+@numba.njit(cache=True)
+def node_to_face(x, k, mode, which, offset, lam, eps, area, tangent, f, K):
+    """Gap g, force f (3 (1 + k),) and (``tangent``) K = ∂f/∂x (3 (1 + k), 3 (1 + k)) of one pair
+    x (1 + k, 3) in ``mode`` 0 (face), 1 (edge ``which``), 2 (vertex ``which``)."""
+    g = _force(x, k, mode, which, offset, lam, eps, area, f)
+    if tangent:
+        m = 3 * (1 + k)
+        xc = x.astype(np.complex128)
+        fc = np.empty(m, dtype=np.complex128)
+        for j in range(m):
+            node, d = divmod(j, 3)
+            xc[node, d] += 1j * H
+            _force(xc, k, mode, which, offset, lam, eps, area, fc)
+            xc[node, d] = x[node, d]
+            for i in range(m):
+                K[i, j] = fc[i].imag / H
+    return g
+
+
+@numba.njit(cache=True)
+def pairs_to_faces(xs, xm, faces, nodes, s, m, mode, which, offset, lam, eps, area, tangent, g, f, K):
+    """node_to_face for pairs (slave s[i], face m[i]) of slaves xs (ns, 3) against faces (nf, 4)
+    of master nodes xm (nm, 3) with ``nodes`` (nf,) nodes each (3: the fourth entry unused):
+    g (p,), f (p, 15), K (p, 15, 15), zero beyond a triangle's 12 dofs."""
+    for i in range(len(s)):
+        k = nodes[m[i]]
+        x = np.empty((1 + k, 3))
+        x[0] = xs[s[i]]
+        for a in range(k):
+            x[1 + a] = xm[faces[m[i], a]]
+        fi = np.zeros(3 * (1 + k))
+        Ki = np.zeros((3 * (1 + k), 3 * (1 + k)))
+        g[i] = node_to_face(x, k, mode[i], which[i], offset[i], lam[i], eps[i], area[i], tangent, fi, Ki)
+        f[i, :] = 0.0
+        K[i, :, :] = 0.0
+        f[i, : 3 * (1 + k)] = fi
+        K[i, : 3 * (1 + k), : 3 * (1 + k)] = Ki
+
+
+@numba.njit(cache=True)
+def _closest_real(xs, xm, face, k, tol):
+    """Allocation-free closest point of slave xs (3,) on face ``face`` (node indices into xm):
+    (ξ, η, signed distance along the face normal there, on the face within ``tol``)."""
+    ox, oy, oz = xm[face[0], 0], xm[face[0], 1], xm[face[0], 2]
+    px, py, pz = xs[0] - ox, xs[1] - oy, xs[2] - oz
+    if k == 3:
+        ax, ay, az = xm[face[1], 0] - ox, xm[face[1], 1] - oy, xm[face[1], 2] - oz
+        bx, by, bz = xm[face[2], 0] - ox, xm[face[2], 1] - oy, xm[face[2], 2] - oz
+        a11 = ax * ax + ay * ay + az * az
+        a12 = ax * bx + ay * by + az * bz
+        a22 = bx * bx + by * by + bz * bz
+        r1 = px * ax + py * ay + pz * az
+        r2 = px * bx + py * by + pz * bz
+        det = a11 * a22 - a12 * a12
+        xi = (a22 * r1 - a12 * r2) / det
+        eta = (a11 * r2 - a12 * r1) / det
+        nx, ny, nz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+        cx, cy, cz = xi * ax + eta * bx, xi * ay + eta * by, xi * az + eta * bz
+        on = xi >= -tol and eta >= -tol and xi + eta <= 1.0 + tol
+    else:
+        # x(ξ, η) = c0 + ξ c1 + η c2 + ξη c3 (corners counter-clockwise at (∓1, ∓1)), from node 0
+        x1 = xm[face[1]]
+        x2 = xm[face[2]]
+        x3 = xm[face[3]]
+        q1x, q1y, q1z = x1[0] - ox, x1[1] - oy, x1[2] - oz
+        q2x, q2y, q2z = x2[0] - ox, x2[1] - oy, x2[2] - oz
+        q3x, q3y, q3z = x3[0] - ox, x3[1] - oy, x3[2] - oz
+        c0x, c0y, c0z = 0.25 * (q1x + q2x + q3x), 0.25 * (q1y + q2y + q3y), 0.25 * (q1z + q2z + q3z)
+        c1x, c1y, c1z = 0.25 * (q1x + q2x - q3x), 0.25 * (q1y + q2y - q3y), 0.25 * (q1z + q2z - q3z)
+        c2x, c2y, c2z = 0.25 * (q2x + q3x - q1x), 0.25 * (q2y + q3y - q1y), 0.25 * (q2z + q3z - q1z)
+        c3x, c3y, c3z = 0.25 * (q2x - q1x - q3x), 0.25 * (q2y - q1y - q3y), 0.25 * (q2z - q1z - q3z)
+        xi = 0.0
+        eta = 0.0
+        ok = False
+        for it in range(_NEWTON_ITERATIONS):
+            t1x, t1y, t1z = c1x + eta * c3x, c1y + eta * c3y, c1z + eta * c3z
+            t2x, t2y, t2z = c2x + xi * c3x, c2y + xi * c3y, c2z + xi * c3z
+            ex = px - (c0x + xi * c1x + eta * c2x + xi * eta * c3x)
+            ey = py - (c0y + xi * c1y + eta * c2y + xi * eta * c3y)
+            ez = pz - (c0z + xi * c1z + eta * c2z + xi * eta * c3z)
+            r1 = ex * t1x + ey * t1y + ez * t1z
+            r2 = ex * t2x + ey * t2y + ez * t2z
+            a11 = t1x * t1x + t1y * t1y + t1z * t1z
+            a22 = t2x * t2x + t2y * t2y + t2z * t2z
+            e12 = ex * c3x + ey * c3y + ez * c3z
+            a12 = t1x * t2x + t1y * t2y + t1z * t2z - e12
+            det = a11 * a22 - a12 * a12
+            if not det > 1e-14 * a11 * a22:
+                a12 += e12
+                det = a11 * a22 - a12 * a12
+                if not det > 0.0:
+                    break
+            dxi = (a22 * r1 - a12 * r2) / det
+            deta = (a11 * r2 - a12 * r1) / det
+            step = abs(dxi) + abs(deta)
+            if step > 1.0:
+                dxi /= step
+                deta /= step
+            xi += dxi
+            eta += deta
+            if step < 1e-13:
+                ok = True
+                break
+        t1x, t1y, t1z = c1x + eta * c3x, c1y + eta * c3y, c1z + eta * c3z
+        t2x, t2y, t2z = c2x + xi * c3x, c2y + xi * c3y, c2z + xi * c3z
+        nx, ny, nz = t1y * t2z - t1z * t2y, t1z * t2x - t1x * t2z, t1x * t2y - t1y * t2x
+        cx = c0x + xi * c1x + eta * c2x + xi * eta * c3x
+        cy = c0y + xi * c1y + eta * c2y + xi * eta * c3y
+        cz = c0z + xi * c1z + eta * c2z + xi * eta * c3z
+        on = ok and abs(xi) <= 1.0 + tol and abs(eta) <= 1.0 + tol
+    norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+    dist = ((px - cx) * nx + (py - cy) * ny + (pz - cz) * nz) / norm
+    return xi, eta, dist, on
+
+
+@numba.njit(cache=True)
+def closest_on_faces(xs, xm, faces, nodes, s, m, tol, out_xi, out_eta, out_dist, out_inside):
+    """For each candidate pair (s[i], m[i]): the projection (ξ, η) on the face's surface, the signed
+    distance along its normal and whether the projection lies on the face (within ``tol``)."""
+    for i in range(len(s)):
+        xi, eta, dist, on = _closest_real(xs[s[i]], xm, faces[m[i]], nodes[m[i]], tol)
+        out_xi[i] = xi
+        out_eta[i] = eta
+        out_dist[i] = dist
+        out_inside[i] = on

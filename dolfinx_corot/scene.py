@@ -24,6 +24,7 @@ import numpy as np
 
 from .conditions import Condition
 from .contact.interface import Contact, Interface
+from .contact.interface3d import Interface3D
 from .contact.laws import Penalty
 from .contact.pair import ContactPair
 from .io.mesh import TaggedMesh
@@ -305,26 +306,31 @@ class Scene:
         return condition
 
     def contact(self, slaves: tuple[PartRef, str], masters: tuple[PartRef, str], law=None,
-                symmetric: bool = False, smooth: bool = True) -> list:
-        """Node-to-segment contact (2D, frictionless) of the nodes of boundary group ``slaves[1]``
-        of part ``slaves[0]`` against the boundary segments of ``masters``; ``symmetric`` adds
-        the other direction (two-pass contact, for two deformable bodies).
+                symmetric: bool = False, smooth: bool | None = None) -> list:
+        """Frictionless node-to-segment (2D) or node-to-face (3D: faces of linear tetrahedra and
+        hexahedra) contact of the nodes of boundary group ``slaves[1]`` of part ``slaves[0]``
+        against the boundary segments or faces of ``masters``; ``symmetric`` adds the other
+        direction (two-pass contact, for two deformable bodies).
 
         law: dc.Penalty() (default) or dc.AugmentedLagrangian(); the default penalty scales with
         the bodies' stiffness and the master segments' length.
-        smooth: the master surface is the C¹ Hermite curve through its nodes (normals continuous
-        from segment to segment: robust sliding over curved and deforming masters); False: the
-        straight segments (slave forces shared linearly by the segment's two nodes: the patch
-        test is passed exactly).
+        smooth (2D; default True): the master surface is the C¹ Hermite curve through its nodes
+        (normals continuous from segment to segment: robust sliding over curved and deforming
+        masters); False: the straight segments (slave forces shared linearly by the segment's two
+        nodes: the patch test is passed exactly). 3D: flat faces with edge and vertex contact.
 
         Returns a :class:`~dolfinx_corot.contact.ContactPair`, the sequence of the interfaces made
         (one, or two when symmetric), which gives the interface pressure of both passes combined
         on either side's contact face (``pair.pressure(on="slaves")``, a beam's face at half its
         depth) and its resultant; see also :meth:`monitor_contact`."""
         law = Penalty() if law is None else law
-        made = [Interface(slaves, masters, law, smooth)]
+        if slaves[0].model.gdim == 3:
+            kind, smooth = Interface3D, bool(smooth)
+        else:
+            kind, smooth = Interface, smooth is None or bool(smooth)
+        made = [kind(slaves, masters, law, smooth)]
         if symmetric:
-            made.append(Interface(masters, slaves, law, smooth))
+            made.append(kind(masters, slaves, law, smooth))
         self.interfaces += made
         return ContactPair(made)
 
@@ -459,9 +465,11 @@ class Scene:
         for itf in self.interfaces:
             d = itf.describe()
             kind = "augmented Lagrangian" if itf.law.augmented else "penalty"
-            surface = "smooth master curve" if itf.smooth else "straight master segments"
+            faces = isinstance(itf, Interface3D)
+            surface = ("flat master faces" if faces else
+                       "smooth master curve" if itf.smooth else "straight master segments")
             out.append(f"contact {itf.name}: {d['slave_nodes']} slave nodes on {d['master_segments']} "
-                       f"segments ({kind}, penalty {itf.penalty:.3g}, {surface})")
+                       f"{'faces' if faces else 'segments'} ({kind}, penalty {itf.penalty:.3g}, {surface})")
         out += [s.effect() for s in self.stabilisers]
         return out
 

@@ -276,6 +276,14 @@ class Interface:
                 return x, float(xi[0])
         return None, None
 
+    def pair_dofs(self, slaves: np.ndarray, segments: np.ndarray) -> np.ndarray:
+        """Global dofs (k, 10) of slave–segment pairs (slave, p, a, b, q), −1 on constrained dofs
+        (PETSc skips them in matrices)."""
+        ext, gd = self.ext[segments], self.master_gdofs
+        dofs = np.hstack([self.slave_gdofs[slaves]] + [gd[ext[:, j]] for j in range(4)])
+        dofs[np.isin(dofs, self.constrained)] = -1
+        return dofs
+
     def _global_dofs(self, surf, system) -> np.ndarray:
         """(n, gdim) global dofs of the surface's nodes' translations in ``system``, on every rank."""
         g = system.global_dofs(surf.part, surf.local_dofs().ravel()).reshape(-1, surf.gdim)
@@ -637,7 +645,7 @@ class Contact(Contribution):
 
     def couplings(self) -> np.ndarray:
         """The 10 dofs (slave, p, a, b, q) of every candidate pair of this rank."""
-        blocks = [_pair_dofs(itf, itf.candidates[:, 0], itf.candidates[:, 1]) for itf in self.interfaces]
+        blocks = [itf.pair_dofs(itf.candidates[:, 0], itf.candidates[:, 1]) for itf in self.interfaces]
         return np.concatenate(blocks) if blocks else np.zeros((0, 10), dtype=np.int64)
 
     def engaged(self) -> bool:
@@ -655,7 +663,7 @@ class Contact(Contribution):
     def add_tangent(self, add) -> None:
         for itf, (K, (s, m)) in zip(self.interfaces, self._blocks):
             if len(s):
-                add(_pair_dofs(itf, s, m), _positive_part(K) if self.project else K)
+                add(itf.pair_dofs(s, m), _positive_part(K) if self.project else K)
 
     def start_stage(self, approach: str) -> None:
         """Approach I: each slave meeting a master for the first time takes its gap as zero
@@ -696,7 +704,7 @@ class Contact(Contribution):
         for itf, (s, m, f) in virtual:
             itf.band_used += 1
             if len(s):
-                dofs.append(_pair_dofs(itf, s, m))
+                dofs.append(itf.pair_dofs(s, m))
                 forces.append(f)
         return np.concatenate(dofs), np.concatenate(forces)
 
@@ -773,12 +781,3 @@ class Contact(Contribution):
 
     def describe(self) -> dict:
         return {"name": self.name, "interfaces": [itf.describe() for itf in self.interfaces]}
-
-
-def _pair_dofs(itf, slaves, segments) -> np.ndarray:
-    """Global dofs (k, 10) of slave–segment pairs (slave, p, a, b, q), −1 on constrained dofs
-    (PETSc skips them in matrices)."""
-    ext, gd = itf.ext[segments], itf.master_gdofs
-    dofs = np.hstack([itf.slave_gdofs[slaves]] + [gd[ext[:, j]] for j in range(4)])
-    dofs[np.isin(dofs, itf.constrained)] = -1
-    return dofs

@@ -238,10 +238,27 @@ def _force(x, k, mode, which, offset, lam, eps, area, f):
 
 
 @numba.njit(cache=True)
-def node_to_face(x, k, mode, which, offset, lam, eps, area, tangent, f, K):
+def node_to_face(x, k, mode, which, offset, lam, eps, area, tangent, f, K, touch=0.0):
     """Gap g, force f (3 (1 + k),) and (``tangent``) K = ∂f/∂x (3 (1 + k), 3 (1 + k)) of one pair
-    x (1 + k, 3) in ``mode`` 0 (face), 1 (edge ``which``), 2 (vertex ``which``)."""
+    x (1 + k, 3) in ``mode`` 0 (face), 1 (edge ``which``), 2 (vertex ``which``). A pair open by
+    less than ``touch`` (λ − ε g ≥ −ε touch, no force) keeps the penalty stiffness A ε ∇g ∇gᵀ in
+    its tangent: bodies touching without load are held in the linearization."""
     g = _force(x, k, mode, which, offset, lam, eps, area, f)
+    if tangent and lam - eps * g <= 0.0:
+        K[:, :] = 0.0
+        if lam - eps * g >= -eps * touch:
+            N = np.empty(k)
+            n = np.empty(3)
+            _contact_point(x, k, mode, which, N, n)
+            grad = np.zeros(3 * (1 + k))
+            for d in range(3):
+                grad[d] = n[d]
+                for a in range(k):
+                    grad[3 + 3 * a + d] = -N[a] * n[d]
+            for i in range(3 * (1 + k)):
+                for j in range(3 * (1 + k)):
+                    K[i, j] = area * eps * grad[i] * grad[j]
+        return g
     if tangent:
         m = 3 * (1 + k)
         xc = x.astype(np.complex128)
@@ -257,10 +274,11 @@ def node_to_face(x, k, mode, which, offset, lam, eps, area, tangent, f, K):
 
 
 @numba.njit(cache=True)
-def pairs_to_faces(xs, xm, faces, nodes, s, m, mode, which, offset, lam, eps, area, tangent, g, f, K):
+def pairs_to_faces(xs, xm, faces, nodes, s, m, mode, which, offset, lam, eps, area, tangent, g, f, K, touch=0.0):
     """node_to_face for pairs (slave s[i], face m[i]) of slaves xs (ns, 3) against faces (nf, 4)
     of master nodes xm (nm, 3) with ``nodes`` (nf,) nodes each (3: the fourth entry unused):
-    g (p,), f (p, 15), K (p, 15, 15), zero beyond a triangle's 12 dofs."""
+    g (p,), f (p, 15), K (p, 15, 15), zero beyond a triangle's 12 dofs; ``touch`` as in
+    :func:`node_to_face`."""
     for i in range(len(s)):
         k = nodes[m[i]]
         x = np.empty((1 + k, 3))
@@ -269,7 +287,7 @@ def pairs_to_faces(xs, xm, faces, nodes, s, m, mode, which, offset, lam, eps, ar
             x[1 + a] = xm[faces[m[i], a]]
         fi = np.zeros(3 * (1 + k))
         Ki = np.zeros((3 * (1 + k), 3 * (1 + k)))
-        g[i] = node_to_face(x, k, mode[i], which[i], offset[i], lam[i], eps[i], area[i], tangent, fi, Ki)
+        g[i] = node_to_face(x, k, mode[i], which[i], offset[i], lam[i], eps[i], area[i], tangent, fi, Ki, touch)
         f[i, :] = 0.0
         K[i, :, :] = 0.0
         f[i, : 3 * (1 + k)] = fi

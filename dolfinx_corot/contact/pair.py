@@ -40,12 +40,12 @@ class InterfacePressure:
     rank.
 
     keys: (n,) the nodes (global block numbers of the side's part, as ``Surface.keys``);
-    x: (n, 2) points of the contact face at the nodes (a beam's axis node moved by half its
+    x: (n, gdim) points of the contact face at the nodes (a beam's axis node moved by half its
     depth towards the other body), current or reference positions;
     pressure: (n,) p_i = −F_i·n_i / L_i (≥ 0 in compression);
-    length: (n,) L_i, the nodes' tributary lengths of the contact face;
-    force: (n, 2) F_i, the force the other body exerts on each node;
-    normal: (n, 2) unit normals of the face towards the other body.
+    length: (n,) L_i, the nodes' tributary lengths (2D) or areas (3D) of the contact face;
+    force: (n, gdim) F_i, the force the other body exerts on each node;
+    normal: (n, gdim) unit normals of the face towards the other body.
     """
 
     keys: np.ndarray
@@ -57,7 +57,7 @@ class InterfacePressure:
 
     @property
     def resultant(self) -> np.ndarray:
-        """(2,) the force the other body exerts on this side, Σ F_i."""
+        """(gdim,) the force the other body exerts on this side, Σ F_i."""
         return self.force.sum(axis=0)
 
     @property
@@ -137,6 +137,8 @@ class ContactPair:
         slaves_side = self.on_slaves(on)
         first = self.interfaces[0]
         surf = first.slave if slaves_side else first.master
+        if surf.gdim == 3:
+            return self._pressure_3d(surf, slaves_side, current)
         internal = np.zeros((len(surf.keys), 2))
         for k, itf in enumerate(self.interfaces):
             s, m, f = itf.contact_forces
@@ -154,17 +156,37 @@ class ContactPair:
         pressure = -np.einsum("ij,ij->i", force, normal) / length
         return InterfacePressure(surf.keys, face, pressure, length, force, normal)
 
+    def _pressure_3d(self, surf, slaves_side: bool, current: bool) -> InterfacePressure:
+        """The 3D interface pressure on a solid's faces: the nodal contact forces of both passes over
+        the nodes' tributary areas, along the area-weighted mean outward normal at each node."""
+        from .interface3d import tributary_areas
+
+        first = self.interfaces[0]
+        internal = sum(itf.nodal_forces((k == 0) == slaves_side) for k, itf in enumerate(self.interfaces))
+        total = np.zeros_like(internal)
+        first.comm.Allreduce(internal, total, op=MPI.SUM)
+        force = -total
+        x = surf.positions(first.comm) if current else surf.X
+        faces = surf.facets
+        normal = np.zeros_like(x)
+        for j in range(faces.shape[1]):  # each corner's normal (x_{j+1} − x_j) × (x_{j−1} − x_j)
+            a, b, c = faces[:, j], faces[:, (j + 1) % faces.shape[1]], faces[:, j - 1]
+            np.add.at(normal, a, np.cross(x[b] - x[a], x[c] - x[a]))
+        normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+        area = tributary_areas(x, faces)
+        pressure = -np.einsum("ij,ij->i", force, normal) / area
+        return InterfacePressure(surf.keys, x, pressure, area, force, normal)
+
     def resultant(self, on: str = "slaves") -> np.ndarray:
-        """(2,) the total force that the other body exerts on the ``on`` side (both passes)."""
+        """(gdim,) the total force that the other body exerts on the ``on`` side (both passes)."""
         return self.pressure(on).resultant
 
     def monitor_values(self, name: str, on: str) -> dict[str, float]:
         """History columns of the pair: name_Fx, name_Fy (the resultant on the ``on`` side),
         name_N (the total normal force) and name_pmax (the largest nominal pressure)."""
         p = self.pressure(on)
-        fx, fy = p.resultant
-        return {f"{name}_Fx": float(fx), f"{name}_Fy": float(fy), f"{name}_N": p.normal_force,
-                f"{name}_pmax": p.max_pressure}
+        out = {f"{name}_F{axis}": float(v) for axis, v in zip("xyz", p.resultant)}
+        return {**out, f"{name}_N": p.normal_force, f"{name}_pmax": p.max_pressure}
 
 
 def _chains(facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -630,6 +630,8 @@ class Solid(AdditiveState, Part):
         ``body`` (a cell group): a line between a cell of ``body`` and one of another region is the
         face of the ``body`` cell (e.g. a fill's face along a structure, on cells excavated before
         the fill appears); lines with cells of the solid on both sides otherwise are refused."""
+        if self.gdim == 3:
+            return self._surface_3d(where, body)
         if self.gdim != 2:
             return super().surface(where, body)
         if self.degree != 1:
@@ -678,7 +680,69 @@ class Solid(AdditiveState, Part):
             side = f" (between two cells of '{body}' or of other regions)" if body else ""
             raise SurfaceError(f"contact surface '{where}': some of its lines lie inside the solid{side}, "
                                "not on its boundary")
-        E, nu = self.E.x.array, self.nu.x.array
-        modulus = self.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN)
         return gather_surface(self, where, np.array(seg_blocks, dtype=np.int64).reshape(-1, 2), Xdof,
-                              modulus=modulus, cells=np.array(seg_cells, dtype=np.int32))
+                              modulus=self._contact_modulus(), cells=np.array(seg_cells, dtype=np.int32))
+
+    def _contact_modulus(self) -> float:
+        """The smallest E/(1 − ν²) of the solid's materials: the stiffness scale of a default penalty."""
+        E, nu = self.E.x.array, self.nu.x.array
+        return self.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN)
+
+    def _surface_3d(self, where: str, body: str | None) -> Surface:
+        """The boundary faces of facet group ``where`` of a linear 3D solid (triangles of tetrahedra,
+        quadrilaterals of hexahedra), their nodes counter-clockwise seen from outside (the normal
+        (x₂ − x₁) × (x₃ − x₁) points out of the body); ``body`` as in 2D."""
+        if self.degree != 1:
+            raise SurfaceError(f"contact surface '{where}': node-to-face contact needs linear solids (degree 1); "
+                               f"this solid has degree {self.degree}")
+        tm = self.tmesh
+        facets = tm.facets(where)
+        if facets is None:
+            raise SurfaceError(f"contact surface '{where}' is not a group of boundary faces of the solid mesh "
+                               f"(groups: {sorted(tm.groups)})")
+        mesh = tm.mesh
+        mesh.topology.create_connectivity(2, 3)
+        mesh.topology.create_connectivity(2, 0)
+        f2c, f2v = mesh.topology.connectivity(2, 3), mesh.topology.connectivity(2, 0)
+        c2v = mesh.topology.connectivity(3, 0)
+        n_owned_cells = mesh.topology.index_map(3).size_local
+        Xdof = self.V.tabulate_dof_coordinates()
+        in_body = None
+        if body:
+            cmap = mesh.topology.index_map(3)
+            in_body = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
+            in_body[tm.cells(body)] = True
+        face_blocks, face_cells, inner = [], [], 0
+        for f in facets:
+            cells = f2c.links(f)
+            if len(cells) == 2 and in_body is not None and in_body[cells].sum() == 1:
+                cells = cells[in_body[cells]]
+            if len(cells) != 1:
+                inner += 1
+                continue
+            c = cells[0]
+            if c >= n_owned_cells:
+                continue  # the owner of the cell adds this face
+            cv = list(c2v.links(c))
+            cd = self.V.dofmap.cell_dofs(c)
+            nodes = np.array([cd[cv.index(v)] for v in f2v.links(f)])
+            x = Xdof[nodes]
+            centre = x.mean(axis=0)
+            if len(nodes) == 4:  # the quadrilateral's corners in cyclic order around its centre
+                normal = np.cross(x[1] - x[0], x[2] - x[0])
+                e1 = x[0] - centre
+                e1 /= np.linalg.norm(e1)
+                e2 = np.cross(normal / np.linalg.norm(normal), e1)
+                nodes = nodes[np.argsort(np.arctan2((x - centre) @ e2, (x - centre) @ e1))]
+                x = Xdof[nodes]
+            if np.dot(np.cross(x[1] - x[0], x[2] - x[0]), centre - Xdof[cd].mean(axis=0)) < 0.0:
+                nodes = nodes[::-1]  # counter-clockwise seen from outside
+            face_blocks.append(nodes)
+            face_cells.append(c)
+        if self.comm.allreduce(inner, op=MPI.SUM):
+            side = f" (between two cells of '{body}' or of other regions)" if body else ""
+            raise SurfaceError(f"contact surface '{where}': some of its faces lie inside the solid{side}, "
+                               "not on its boundary")
+        nv = 4 if mesh.topology.cell_name() == "hexahedron" else 3
+        return gather_surface(self, where, np.array(face_blocks, dtype=np.int64).reshape(-1, nv), Xdof,
+                              modulus=self._contact_modulus(), cells=np.array(face_cells, dtype=np.int32))

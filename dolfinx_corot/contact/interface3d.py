@@ -1,0 +1,337 @@
+r"""Contact interfaces in 3D: slave nodes of one body against master faces of another.
+
+An :class:`Interface3D` is the 3D counterpart of :class:`~dolfinx_corot.contact.interface.Interface`
+and takes its place in the scene's :class:`~dolfinx_corot.contact.interface.Contact` contribution
+(same laws, Newton hooks, state and staging). Every rank holds both surfaces whole; each rank
+evaluates the slaves whose x dof it owns. At each evaluation
+
+1. the broad phase (:mod:`.search3d`) finds the faces whose bounding box, inflated by the search
+   margin (half a mean edge) and the offsets, holds a slave; the candidate list only grows until
+   a slave has moved by half the margin since the last search (the pattern of the contact
+   matrix is rebuilt only then);
+2. each slave takes, among its candidate faces, the one onto which its closest point falls (within
+   a small tolerance beyond the edges) with the smallest |g|, chosen afresh at every evaluation: a
+   slave may change master face at any iteration. A slave that falls onto no face but lies
+   within the margin of a convex edge or vertex of one (beyond the faces on both sides) meets that
+   edge or vertex (:mod:`.kernels3d`, modes 1 and 2): crossing from face to edge to face the
+   contact point and the gap are continuous;
+3. the kernels give the pair's gap, force and tangent (15 dofs: the slave, then four face nodes;
+   a triangle's fourth is none).
+
+The slaves' tributary areas are those of the slave surface in the reference configuration
+(∫ N_a dA over the faces at each node). Frictionless.
+"""
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+
+from . import kernels3d
+from .interface import Interface
+from .laws import ContactError, Penalty
+from .search3d import broad_phase_boxes, face_boxes
+
+PAIR_DOFS = kernels3d.PAIR_DOFS
+
+
+def tributary_areas(X: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(n,) ∫ N_a dA of each node a over the faces (m, 3 or 4) of nodes X (n, 3): a third of each
+    triangle's area; for quadrilaterals by 2 × 2 Gauss points on the bilinear surface."""
+    out = np.zeros(len(X))
+    x = X[faces]
+    if faces.shape[1] == 3:
+        area = 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
+        for j in range(3):
+            np.add.at(out, faces[:, j], area / 3.0)
+        return out
+    g = 1.0 / np.sqrt(3.0)
+    sx, sy = kernels3d.QUAD_XI, kernels3d.QUAD_ETA
+    for xi in (-g, g):
+        for eta in (-g, g):
+            N = 0.25 * (1 + sx * xi) * (1 + sy * eta)
+            t1 = np.einsum("a,mad->md", 0.25 * sx * (1 + sy * eta), x)
+            t2 = np.einsum("a,mad->md", 0.25 * sy * (1 + sx * xi), x)
+            J = np.linalg.norm(np.cross(t1, t2), axis=1)
+            for j in range(4):
+                np.add.at(out, faces[:, j], N[j] * J)
+    return out
+
+
+class Interface3D(Interface):
+    """One direction of 3D contact: the nodes of ``slaves`` against the faces of ``masters``
+    (each a (part, boundary group name) pair)."""
+
+    INSIDE_TOLERANCE = 1e-9  # a projection this far (in the face's parameters) beyond an edge is on it
+    FREE_EDGE_TOLERANCE = 0.05  # beyond an edge of the surface's border: this far (× the face) still on it
+
+    def __init__(self, slaves, masters, law: Penalty, smooth: bool = False):
+        if not isinstance(law, Penalty):
+            raise TypeError(f"contact law must be dc.Penalty or dc.AugmentedLagrangian, got {type(law).__name__}")
+        if smooth:
+            raise ContactError("3D contact: the smoothed master surface is not available yet; give smooth=False "
+                               "(flat faces with edge and vertex contact)")
+        if slaves[0].model is masters[0].model and slaves[1] == masters[1]:
+            raise ContactError(f"contact of surface '{slaves[1]}' with itself is not supported: give two "
+                               "surfaces (self-contact is not implemented)")
+        self.slave_spec, self.master_spec, self.law = slaves, masters, law
+        self.slave = slaves[0].model.surface(slaves[1], body=slaves[0].name or None)
+        self.master = masters[0].model.surface(masters[1], body=masters[0].name or None)
+        for surf, spec in ((self.slave, slaves), (self.master, masters)):
+            if surf.dim != 2:
+                raise ContactError(f"3D contact: '{spec[1]}' of {spec[0].kind} '{spec[0].name}' is not a surface of "
+                                   "faces (3D solids are supported so far)")
+        self.name = f"{slaves[1]} -> {masters[1]}"
+        self.area = tributary_areas(self.slave.X, self.slave.facets)
+        faces = self.master.facets
+        k = faces.shape[1]
+        self.faces = np.hstack([faces, np.repeat(faces[:, :1], 4 - k, axis=1)]).astype(np.int64)
+        self.nodes = np.full(len(faces), k, dtype=np.int64)
+        # the edges (j, j + 1) of each face that border the surface (one face only): a slave a little
+        # beyond them still meets the face, as in 2D beyond a free end
+        pairs = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], axis=2), axis=2).reshape(-1, 2)
+        _, inverse, count = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
+        self.free_edge = (count[inverse] == 1).reshape(len(faces), k)
+        self.two_sided = self.master.two_sided
+        self.master_offset = self.master.offsets
+        self.slave_face = self.slave.node_offsets()
+        Xm = self.master.X
+        edges = np.linalg.norm(Xm[faces] - Xm[np.roll(faces, -1, axis=1)], axis=2)
+        self.h = float(edges.mean())
+        if law.penalty is not None:
+            if not law.penalty > 0.0:
+                raise ValueError(f"contact '{self.name}': the penalty must be positive, got {law.penalty}")
+            self.penalty = float(law.penalty)
+        else:
+            moduli = [surf.modulus for surf in (self.slave, self.master) if surf.modulus is not None]
+            if not moduli:
+                raise ContactError(f"contact '{self.name}': the penalty has no solid to scale with: give it, e.g. "
+                                   "dc.Penalty(penalty=...)")
+            self.penalty = law.factor * min(moduli) / self.h
+        self.smooth = False
+        self.multiplier = np.zeros(len(self.area))
+        self.margin = 0.5 * self.h
+        both = np.vstack([self.slave.X, Xm])
+        self.size = float(np.linalg.norm(both.max(axis=0) - both.min(axis=0)))
+        self.touch = 1e-6 * self.h
+        self.uzawa_updates = 0
+        self.slave_on = self.segment_on = None
+        self.exists = True
+        self.initial_gap = np.zeros(len(self.area))
+        self.gap_cancelled = np.zeros(len(self.area), dtype=bool)
+        self._virtual = None
+
+    # -- pairs ------------------------------------------------------------------------------
+    def pair_dofs(self, slaves: np.ndarray, faces: np.ndarray) -> np.ndarray:
+        """Global dofs (k, 15) of slave–face pairs (slave, then the face's four nodes; a triangle's
+        fourth node and constrained dofs −1: PETSc skips them)."""
+        gd = self.master_gdofs
+        dofs = np.hstack([self.slave_gdofs[slaves]] + [gd[self.faces[faces, j]] for j in range(4)])
+        dofs[:, 12:][self.nodes[faces] == 3] = -1
+        dofs[np.isin(dofs, self.constrained)] = -1
+        return dofs
+
+    def _search(self, xs, xm) -> None:
+        moved = np.inf if self.anchor is None else max(
+            np.abs(xs - self.anchor[0]).max(initial=0.0), np.abs(xm - self.anchor[1]).max(initial=0.0))
+        if moved <= 0.5 * self.margin:
+            return
+        reach = self.margin + self.slave_offset.max(initial=0.0) + self.master_offset
+        lo, hi = face_boxes(xm, self.master.facets, reach)
+        pairs = broad_phase_boxes(xs[self.mine], lo, hi)
+        pairs[:, 0] = self.mine[pairs[:, 0]]
+        pairs = self._existing_pairs(pairs)
+        union = np.unique(np.vstack([self.candidates, pairs]), axis=0)
+        grown = self.comm.allreduce(int(len(union) > len(self.candidates)), op=MPI.MAX)
+        if grown:
+            self.candidates = union
+            self.pairs_changed = True
+        self.anchor = (xs.copy(), xm.copy())
+
+    def _assign(self, xs, xm, pairs):
+        """(face, mode, which), each (n_slaves,), of this rank's candidate pairs: mode 0 on the face,
+        1 on its edge ``which``, 2 at its vertex ``which``; face −1: no partner."""
+        n = len(self.area)
+        face = np.full(n, -1)
+        mode = np.zeros(n, dtype=np.int64)
+        which = np.zeros(n, dtype=np.int64)
+        if not len(pairs):
+            return face, mode, which
+        s, m = pairs[:, 0], pairs[:, 1]
+        k = len(pairs)
+        xi, eta, dist = np.zeros(k), np.zeros(k), np.zeros(k)
+        on = np.zeros(k, dtype=bool)
+        kernels3d.closest_on_faces(xs, xm, self.faces, self.nodes, s, m, self.INSIDE_TOLERANCE, xi, eta, dist, on)
+        g = dist - self.slave_offset[s] - self.master_offset[m]
+        on |= self._beyond_free_edges(m, xi, eta)
+        valid = on & (g > -self.h) & (g < self.margin)
+        if valid.any():
+            v = np.flatnonzero(valid)
+            order = np.lexsort((m[v], np.abs(g[v]), s[v]))
+            first = v[order][np.r_[True, np.diff(s[v[order]]) != 0]]
+            face[s[first]] = m[first]
+        # slaves on no face: the nearest point of the faces' edges and vertices, if within the margin
+        rest = np.flatnonzero(face[s] < 0)
+        if len(rest):
+            best = np.full(n, np.inf)
+            for j in range(4):
+                a = self.faces[m[rest], j]
+                b = np.where(j + 1 < self.nodes[m[rest]], self.faces[m[rest], (j + 1) % 4], self.faces[m[rest], 0])
+                real = j < self.nodes[m[rest]]
+                d = xm[b] - xm[a]
+                with np.errstate(invalid="ignore", divide="ignore"):  # (a triangle's fourth edge: not real)
+                    t = np.clip(np.einsum("ij,ij->i", xs[s[rest]] - xm[a], d) / np.einsum("ij,ij->i", d, d), 0.0, 1.0)
+                dist_e = np.linalg.norm(xs[s[rest]] - (xm[a] + t[:, None] * d), axis=1)
+                dist_e -= self.slave_offset[s[rest]] + self.master_offset[m[rest]]
+                for i in np.flatnonzero(real & (dist_e < self.margin)):
+                    slave = s[rest[i]]
+                    if dist_e[i] < best[slave] - 1e-14 * self.h:
+                        best[slave] = dist_e[i]
+                        face[slave] = m[rest[i]]
+                        if 0.0 < t[i] < 1.0:
+                            mode[slave], which[slave] = 1, j
+                        else:
+                            mode[slave], which[slave] = 2, (j if t[i] == 0.0 else (j + 1) % self.nodes[m[rest[i]]])
+        return face, mode, which
+
+    def _beyond_free_edges(self, m: np.ndarray, xi: np.ndarray, eta: np.ndarray) -> np.ndarray:
+        """Whether each projection (ξ, η) on face m lies beyond the face's edges by at most the
+        free-edge tolerance, and only beyond edges that border the surface."""
+        k = self.faces.shape[1] if self.nodes.size == 0 else int(self.nodes[0])
+        if k == 3:  # edges (0, 1): η = 0, (1, 2): ξ + η = 1, (2, 0): ξ = 0
+            over = np.column_stack([-eta, xi + eta - 1.0, -xi])
+        else:  # (0, 1): η = −1, (1, 2): ξ = 1, (2, 3): η = 1, (3, 0): ξ = −1 (in units of the half face)
+            over = 0.5 * np.column_stack([-1.0 - eta, xi - 1.0, eta - 1.0, -1.0 - xi])
+        free = self.free_edge[m]
+        inner_ok = np.all(np.where(free, True, over <= self.INSIDE_TOLERANCE), axis=1)
+        return inner_ok & np.all(over <= self.FREE_EDGE_TOLERANCE, axis=1) & np.any(free & (over > 0.0), axis=1)
+
+    def evaluate(self):
+        """Forces and tangents of this rank's slaves at the current configuration: (dofs (k, 15)
+        global, f (k, 15), K (k, 15, 15), (slave, face) (k,)) over the pairs in contact."""
+        xs, xm = self._positions(self.slave), self._positions(self.master)
+        self._search(xs, xm)
+        self._assigned = self._assign(xs, xm, self.candidates)
+        face, mode, which = self._assigned
+        s = self.mine[face[self.mine] >= 0]
+        m = face[s]
+        self.active[:] = -1
+        self.active[s] = m
+        n = len(s)
+        g = np.zeros(n)
+        f = np.zeros((n, PAIR_DOFS))
+        K = np.zeros((n, PAIR_DOFS, PAIR_DOFS))
+        lam = self.multiplier[s]
+        offset = self.slave_offset[s] + self.master_offset[m]
+        kernels3d.pairs_to_faces(xs, xm, self.faces, self.nodes, s, m, mode[s], which[s], offset, lam,
+                                 np.full(n, self.penalty), self.area[s], True, g, f, K, self.touch)
+        if self.first_evaluation:
+            self.first_evaluation = False
+            self.had_contact = bool(self.comm.allreduce(int(np.any(lam - self.penalty * g > 0.0)), op=MPI.MAX))
+        keep = (lam - self.penalty * g) >= -self.penalty * self.touch
+        self._virtual = None
+        self._last = (s, g)
+        self._x = (xs, xm)
+        self._forces = (s[keep], m[keep], f[keep])
+        return self.pair_dofs(s[keep], m[keep]), f[keep], K[keep], (s[keep], m[keep])
+
+    def cancel_initial_gaps(self, slaves: np.ndarray | None = None) -> int:
+        """Approach I of staged construction: each existing slave (of ``slaves``; None: all) that finds
+        an existing master face for the first time takes its current gap as zero."""
+        xs, xm = self._positions(self.slave), self._positions(self.master)
+        self.anchor = None
+        self._search(xs, xm)
+        face, mode, which = self._assign(xs, xm, self.candidates)
+        s = self.mine[(face[self.mine] >= 0) & ~self.gap_cancelled[self.mine]]
+        if slaves is not None:
+            s = s[np.isin(s, slaves)]
+        g, done = np.zeros(len(self.area)), np.zeros(len(self.area))
+        if len(s):
+            n = len(s)
+            gs = np.zeros(n)
+            kernels3d.pairs_to_faces(xs, xm, self.faces, self.nodes, s, face[s], mode[s], which[s],
+                                     self.slave_offset[s] + self.master_offset[face[s]], np.zeros(n),
+                                     np.full(n, self.penalty), self.area[s], False, gs, np.zeros((n, PAIR_DOFS)),
+                                     np.zeros((n, PAIR_DOFS, PAIR_DOFS)))
+            g[s], done[s] = gs, 1.0
+        g = self.comm.allreduce(g, op=MPI.SUM)
+        done = self.comm.allreduce(done, op=MPI.SUM) > 0.0
+        self.initial_gap[done] = g[done]
+        self.gap_cancelled |= done
+        self.anchor = None
+        return int(done.sum())
+
+    def project_slaves(self, slaves: np.ndarray) -> np.ndarray:
+        raise NotImplementedError("the mapping of new continuum (staged construction, approach II) is 2D so far")
+
+    def correction_ratio(self, ds: np.ndarray, dm: np.ndarray) -> float:
+        """As in 2D (:meth:`Interface.correction_ratio`): the motion of each slave relative to the point
+        of the master it faces, its sliding at most the margin, its approach at most its gap plus
+        the margin, its separation at most the interface's extent; slaves without a partner
+        against their nearest master node."""
+        if not len(self.mine):
+            return 0.0
+        xs, xm = self._x
+        face, mode, which = self._assigned
+        mine = self.mine
+        worst = 0.0
+        gap = np.full(len(self.area), np.inf)
+        s_last, g_last = self._last
+        gap[s_last] = g_last
+        on = mine[face[mine] >= 0]
+        if len(on):
+            m = face[on]
+            # the face's motion: the mean of its nodes' (a rigid face's at its centre)
+            three = (self.nodes[m] == 3)[:, None]
+            dface = np.where(three, dm[self.faces[m, :3]].mean(axis=1), dm[self.faces[m]].mean(axis=1))
+            n = np.cross(xm[self.faces[m, 1]] - xm[self.faces[m, 0]], xm[self.faces[m, 2]] - xm[self.faces[m, 0]])
+            n /= np.linalg.norm(n, axis=1)[:, None]
+            worst = max(worst, self._ratio(ds[on] - dface, n, np.maximum(gap[on], 0.0) + self.margin, self.margin))
+        free = mine[face[mine] < 0]
+        if len(free):
+            from scipy.spatial import cKDTree
+
+            dist, v = cKDTree(xm).query(xs[free])
+            u = (xs[free] - xm[v]) / np.maximum(dist, 1e-300)[:, None]
+            worst = max(worst, self._ratio(ds[free] - dm[v], u, np.maximum(dist, self.margin), dist + self.margin))
+        return worst
+
+    def pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Coordinates (n, 3) and nominal contact pressure ⟨λ − ε g⟩ (n,) of all slave nodes of this
+        pass, on every rank, at the last evaluation (``current``: the nodal force per current
+        tributary area, with the current coordinates)."""
+        s, g = self._last
+        p = np.zeros(len(self.area))
+        p[s] = np.maximum(0.0, self.multiplier[s] - self.penalty * g)
+        out = np.zeros_like(p)
+        self.comm.Allreduce(p, out, op=MPI.SUM)
+        if not current:
+            return self.slave.X, out
+        x = self._positions(self.slave)
+        return x, out * self.area / tributary_areas(x, self.slave.facets)
+
+    def nodal_forces(self, on_slaves: bool) -> np.ndarray:
+        """(n, 3) the contact shares of the internal forces of this pass on the nodes of the slave
+        (or master) surface, this rank's pairs."""
+        s, m, f = self._forces
+        if on_slaves:
+            out = np.zeros((len(self.slave.X), 3))
+            np.add.at(out, s, f[:, :3])
+            return out
+        out = np.zeros((len(self.master.X), 3))
+        for j in range(4):
+            real = j < self.nodes[m]
+            np.add.at(out, self.faces[m[real], j], f[real, 3 + 3 * j: 6 + 3 * j])
+        return out
+
+    def master_pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """The contact forces on each master node over its tributary area (n_master,), with the
+        nodes' coordinates, on every rank."""
+        total = np.zeros((len(self.master.X), 3))
+        self.comm.Allreduce(self.nodal_forces(False), total, op=MPI.SUM)
+        x = self._positions(self.master) if current else self.master.X
+        return x, np.linalg.norm(total, axis=1) / tributary_areas(x, self.master.facets)
+
+    def describe(self) -> dict:
+        return {"slaves": self.slave_spec[1], "masters": self.master_spec[1], "law": repr(self.law),
+                "smooth": False, "penalty": self.penalty, "slave_nodes": len(self.area),
+                "master_segments": len(self.master.facets)}

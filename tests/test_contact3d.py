@@ -1,0 +1,142 @@
+"""3D node-to-face contact between solids (issue 15, first part): two blocks of tetrahedra with
+non-matching faces pressed together. References: the homogeneous uniaxial state of the patch test
+(u_z = −p z/E, u_x = ν p x/E, u_y = ν p y/E), global equilibrium, and central differences of the
+assembled residual."""
+import gmsh
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import dolfinx_corot as dc
+from dolfinx_corot.io.mesh import from_gmsh
+from fd import tangent_and_fd
+
+comm = MPI.COMM_WORLD
+E, NU, P = 100.0, 0.3, 1.0
+
+
+def _two_blocks(h_low: float, h_up: float):
+    """Blocks [0, 1]² × [0, 0.5] ('lower') and [0, 1]² × [0.5, 1] ('upper') of tetrahedra of sizes
+    h_low and h_up, not joined: faces 'lower_face' and 'upper_face' at z = 0.5 (non-matching),
+    'base' (z = 0), 'top' (z = 1), 'x0' and 'y0' (the symmetry planes of both)."""
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("blocks")
+        occ = gmsh.model.occ
+        low, up = occ.addBox(0, 0, 0, 1, 1, 0.5), occ.addBox(0, 0, 0.5, 1, 1, 0.5)
+        occ.synchronize()
+        groups = {}
+        for vol, name, h in ((low, "lower", h_low), (up, "upper", h_up)):
+            gmsh.model.mesh.setSize(gmsh.model.getBoundary([(3, vol)], recursive=True), h)
+            for _, tag in gmsh.model.getBoundary([(3, vol)], oriented=False):
+                x, y, z = occ.getCenterOfMass(2, tag)
+                face = ("base" if z < 1e-9 else "top" if z > 1 - 1e-9 else f"{name}_face" if abs(z - 0.5) < 1e-9
+                        else "x0" if x < 1e-9 else "y0" if y < 1e-9 else None)
+                if face:
+                    groups.setdefault(face, []).append(tag)
+            gmsh.model.setPhysicalName(3, gmsh.model.addPhysicalGroup(3, [vol]), name)
+        for name, tags in groups.items():
+            gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, tags), name)
+        gmsh.model.mesh.generate(3)
+    tm = from_gmsh(gmsh.model, 3, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm
+
+
+def _patch_scene(law, symmetric: bool = True):
+    sc = dc.Scene(large_rotations=False, linear_solver="direct")
+    b = sc.add_solid(_two_blocks(0.26, 0.35), material=dc.Elastic(E, NU), degree=1)
+    sc.fix(b, "base", dofs=("uz",))
+    sc.fix(b, "x0", dofs=("ux",))
+    sc.fix(b, "y0", dofs=("uy",))
+    sc.load(b, "top", traction=(0.0, 0.0, -P))
+    pair = sc.contact((b, "upper_face"), (b, "lower_face"), law=law, symmetric=symmetric)
+    sc.monitor_contact("c", pair)
+    return sc, b, pair
+
+
+def _errors(b):
+    """(largest error of the lower block, of the upper one less its mean) against the homogeneous
+    state, in units of p/E, over all ranks."""
+    m = b.model
+    n = m.V.dofmap.index_map.size_local
+    X = m.V.tabulate_dof_coordinates()[:n]
+    u = m.state.x.array.reshape(-1, 3)[:n]
+    d = u - np.column_stack([NU * P * X[:, 0] / E, NU * P * X[:, 1] / E, -P * X[:, 2] / E])
+    up = X[:, 2] > 0.5 + 1e-9
+    low = comm.allreduce(float(np.abs(d[~up]).max(initial=0.0)), op=MPI.MAX)
+    total = comm.allreduce(d[up].sum(axis=0), op=MPI.SUM)
+    count = comm.allreduce(int(up.sum()), op=MPI.SUM)
+    upper = comm.allreduce(float(np.abs(d[up] - total / count).max(initial=0.0)), op=MPI.MAX)
+    return low / (P / E), upper / (P / E), total / count
+
+
+def test_two_blocks_pressed_through_a_non_matching_interface():
+    """The contact patch test in 3D, two-pass, non-matching triangulations (face sizes 0.26 and
+    0.35, different orientations). The interface transmits the whole load: its resultant is
+    (0, 0, P) to solver tolerance (1e-9; tangential parts below 1e-4 P) and the nominal pressure
+    is within 5.6 % of P at every node with the penalty (measured; bound 6 %: the two passes'
+    penetrations, 1.5e-4 of the height, differ from node to node), within 0.92 % with the
+    augmented Lagrangian (bound 1 %), whose ten Uzawa updates bring both blocks towards the
+    homogeneous state: largest errors 3.0 % and 1.1 % of p/E with the penalty (lower block;
+    upper less its mean shift), 0.25 % and 0.17 % after the updates (bounds: a tenth and a fifth
+    of the penalty's). Two-pass node-to-face contact on non-matching faces does not pass the patch
+    test exactly; reaching 1e-8 is the next step of issue 15."""
+    sc, b, pair = _patch_scene(dc.Penalty())
+    row = dc.solve(sc, dc.LoadControl(steps=1)).history.rows[-1]
+    assert row["c_Fz"] == pytest.approx(P, rel=1e-9)
+    assert abs(row["c_Fx"]) < 1e-4 * P and abs(row["c_Fy"]) < 1e-4 * P
+    p = pair.pressure("slaves").pressure
+    assert np.abs(p - P).max() < 0.06 * P
+    penalty = _errors(b)
+    assert penalty[0] < 0.035 and penalty[1] < 0.015
+
+    sc, b, pair = _patch_scene(dc.AugmentedLagrangian(gap_tolerance=1e-10))
+    row = dc.solve(sc, dc.LoadControl(steps=1)).history.rows[-1]
+    assert row["uzawa_updates"] >= 5
+    assert row["c_Fz"] == pytest.approx(P, rel=1e-9)
+    p = pair.pressure("slaves").pressure
+    assert np.abs(p - P).max() < 0.01 * P
+    augmented = _errors(b)
+    assert augmented[0] < 0.1 * penalty[0] and augmented[1] < 0.2 * penalty[1]
+
+
+@pytest.mark.skipif(comm.size > 1, reason="dense finite differences of the assembled system: serial")
+@pytest.mark.parametrize("symmetric", [False, True])
+def test_assembled_3d_contact_tangent_matches_finite_differences(symmetric):
+    """The system's tangent (blocks + contact) against central differences of its residual at a
+    penetrating, sheared, randomly perturbed state, with augmented-Lagrangian multipliers
+    (slaves on faces, some beyond the border of the master surface): 1e-6 of the largest entry."""
+    from dolfinx_corot.assembly import make_system
+
+    sc, b, pair = _patch_scene(dc.AugmentedLagrangian(), symmetric)
+    for itf in sc.interfaces:
+        itf.multiplier[:] = 0.3 * P
+    system = make_system(sc.model, contributions=sc.contributions())
+    model = sc.model
+    X = model.V.tabulate_dof_coordinates()
+    u = model.state.x.array.reshape(-1, 3)
+    rng = np.random.default_rng(5)
+    upper = X[:, 2] > 0.5 - 1e-12
+    u[:, 2] = np.where(upper, -0.02, 0.0)
+    u[:, 0] = 0.01 * X[:, 2] ** 2
+    u += rng.uniform(-1e-3, 1e-3, u.shape)
+    K, Kfd = tangent_and_fd(system, model.state.x.array, 1.0)
+    fixed = np.concatenate([bc.dof_indices()[0] for bc in system.bcs])
+    free = np.setdiff1d(np.arange(len(K)), fixed)
+    sub = np.ix_(free, free)
+    assert sum(int((itf.active >= 0).sum()) for itf in sc.interfaces) > 10
+    assert np.abs(K[sub] - Kfd[sub]).max() < 1e-6 * np.abs(K[sub]).max()
+    system.destroy()
+
+
+def test_3d_contact_input_is_checked_by_name():
+    """A group that is not a face group of the solid, and the smoothed master (not yet in 3D)."""
+    sc = dc.Scene(large_rotations=False)
+    b = sc.add_solid(_two_blocks(0.5, 0.5), material=dc.Elastic(E, NU), degree=1)
+    with pytest.raises(dc.ContactError, match="smoothed master surface is not available yet"):
+        sc.contact((b, "upper_face"), (b, "lower_face"), smooth=True)
+    with pytest.raises(ValueError, match="'lower' is not a group of boundary faces|contact surface 'lower'"):
+        sc.contact((b, "upper_face"), (b, "lower"))

@@ -15,24 +15,25 @@ comm = MPI.COMM_WORLD
 E, NU, P = 100.0, 0.3, 1.0
 
 
-def _two_blocks(h_low: float, h_up: float):
-    """Blocks [0, 1]² × [0, 0.5] ('lower') and [0, 1]² × [0.5, 1] ('upper') of tetrahedra of sizes
-    h_low and h_up, not joined: faces 'lower_face' and 'upper_face' at z = 0.5 (non-matching),
-    'base' (z = 0), 'top' (z = 1), 'x0' and 'y0' (the symmetry planes of both)."""
+def _two_blocks(h_low: float, h_up: float, gap: float = 0.0):
+    """Blocks [0, 1]² × [0, 0.5] ('lower') and [0, 1]² × [0.5, 1] + gap ('upper') of tetrahedra of
+    sizes h_low and h_up, not joined: faces 'lower_face' at z = 0.5 and 'upper_face' at 0.5 + gap
+    (non-matching), 'base' (z = 0), 'top', 'x0' and 'y0' (the symmetry planes of both)."""
     if comm.rank == 0:
         gmsh.initialize()
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("blocks")
         occ = gmsh.model.occ
-        low, up = occ.addBox(0, 0, 0, 1, 1, 0.5), occ.addBox(0, 0, 0.5, 1, 1, 0.5)
+        low, up = occ.addBox(0, 0, 0, 1, 1, 0.5), occ.addBox(0, 0, 0.5 + gap, 1, 1, 0.5)
         occ.synchronize()
         groups = {}
         for vol, name, h in ((low, "lower", h_low), (up, "upper", h_up)):
             gmsh.model.mesh.setSize(gmsh.model.getBoundary([(3, vol)], recursive=True), h)
             for _, tag in gmsh.model.getBoundary([(3, vol)], oriented=False):
                 x, y, z = occ.getCenterOfMass(2, tag)
-                face = ("base" if z < 1e-9 else "top" if z > 1 - 1e-9 else f"{name}_face" if abs(z - 0.5) < 1e-9
-                        else "x0" if x < 1e-9 else "y0" if y < 1e-9 else None)
+                face = ("base" if z < 1e-9 else "top" if z > 1 + gap - 1e-9 else
+                        f"{name}_face" if min(abs(z - 0.5), abs(z - 0.5 - gap)) < 1e-9 else
+                        "x0" if x < 1e-9 else "y0" if y < 1e-9 else None)
                 if face:
                     groups.setdefault(face, []).append(tag)
             gmsh.model.setPhysicalName(3, gmsh.model.addPhysicalGroup(3, [vol]), name)
@@ -55,6 +56,15 @@ def _patch_scene(law, symmetric: bool = True):
     pair = sc.contact((b, "upper_face"), (b, "lower_face"), law=law, symmetric=symmetric)
     sc.monitor_contact("c", pair)
     return sc, b, pair
+
+
+def _nodal(b) -> dict:
+    """{reference position: displacement} of every node, on every rank (partition-independent)."""
+    m = b.model
+    n = m.V.dofmap.index_map.size_local
+    X = np.concatenate(comm.allgather(np.round(m.V.tabulate_dof_coordinates()[:n], 9)))
+    u = np.concatenate(comm.allgather(m.state.x.array.reshape(-1, 3)[:n]))
+    return {tuple(p): v for p, v in zip(X, u)}
 
 
 def _errors(b):
@@ -140,3 +150,68 @@ def test_3d_contact_input_is_checked_by_name():
         sc.contact((b, "upper_face"), (b, "lower_face"), smooth=True)
     with pytest.raises(ValueError, match="'lower' is not a group of boundary faces|contact surface 'lower'"):
         sc.contact((b, "upper_face"), (b, "lower"))
+
+
+def _blocks_scene(law, swap: bool = False, contact: bool = True, lift: float = 0.0):
+    """The patch test's blocks, two-pass, contact monitored as 'c'; ``swap``: slaves and masters
+    given the other way round; ``lift``: the upper block, 0.3 above the lower one, has its top
+    moved up by this much (prescribed) instead of loaded."""
+    sc = dc.Scene(large_rotations=False, linear_solver="direct")
+    b = sc.add_solid(_two_blocks(0.26, 0.35, 0.3 if lift else 0.0), material=dc.Elastic(E, NU), degree=1)
+    sc.fix(b, "base", dofs=("uz",))
+    sc.fix(b, "x0", dofs=("ux",))
+    sc.fix(b, "y0", dofs=("uy",))
+    if lift:
+        sc.prescribe(b, "top", uz=lift)
+    else:
+        sc.load(b, "top", traction=(0.0, 0.0, -P))
+    if contact:
+        sides = [(b, "upper_face"), (b, "lower_face")]
+        sc.monitor_contact("c", sc.contact(*(sides[::-1] if swap else sides), law=law, symmetric=True))
+    return sc, b
+
+
+@pytest.mark.parametrize("scale", [1e-2, 1.0, 1e4])
+def test_penalties_over_six_decades_converge_and_transmit_the_load(scale):
+    """Hard case: the patch test's two-pass penalty contact with ε from 10⁻² to 10⁴ times the
+    default converges without a cut step and the interface transmits the load to Newton's
+    tolerance (1e-8: the residual is 1e-9 of the force scale, the stiffest penalty measured
+    1.9e-9 on two ranks);
+    each pass carries about half of it, so the slaves' mean penetration is about p/(2ε) (bounds
+    0.3 and 0.7 of p/ε)."""
+    sc, b = _blocks_scene(dc.Penalty(factor=10.0 * scale))
+    result = dc.solve(sc, dc.LoadControl(steps=1))
+    assert result.history.column("cuts").sum() == 0
+    assert result.history.rows[-1]["c_Fz"] == pytest.approx(P, rel=1e-8)
+    eps = sc.interfaces[0].penalty
+    gaps = np.concatenate(comm.allgather(sc.interfaces[0].gaps()[1]))
+    assert 0.3 * P / eps < -gaps.mean() < 0.7 * P / eps
+
+
+def test_swapping_slaves_and_masters_of_symmetric_contact_gives_the_same_answer():
+    """Hard case: two-pass contact declared either way round is the same pair of passes: the
+    displacements agree to solver tolerance (1e-9 of the largest)."""
+    states = []
+    for swap in (False, True):
+        sc, b = _blocks_scene(dc.Penalty(), swap=swap)
+        dc.solve(sc, dc.LoadControl(steps=1))
+        states.append(_nodal(b))
+    scale = max(np.abs(u).max() for u in states[0].values())
+    assert max(np.abs(states[1][p] - u).max() for p, u in states[0].items()) < 1e-9 * scale
+
+
+def test_an_idle_3d_interface_leaves_the_solution_bit_identical():
+    """Hard case (effects on demand): the upper block lifted away from the lower one, with and
+    without a declared interface: the solutions are bit-identical, and no contact matrix is built."""
+    from dolfinx_corot.assembly import make_system
+
+    states = []
+    for contact in (False, True):
+        sc, b = _blocks_scene(dc.Penalty(), contact=contact, lift=0.2)
+        system = make_system(sc.model, solver=sc.linear_solver, contributions=sc.contributions())
+        dc.solve(sc, dc.LoadControl(steps=2), system=system)
+        if contact:
+            assert system.C is None
+        system.destroy()
+        states.append(_nodal(b))
+    assert all(np.array_equal(states[1][p], u) for p, u in states[0].items())

@@ -326,8 +326,20 @@ def _closest_real(xs, xm, face, k, tol):
         c1x, c1y, c1z = 0.25 * (q1x + q2x - q3x), 0.25 * (q1y + q2y - q3y), 0.25 * (q1z + q2z - q3z)
         c2x, c2y, c2z = 0.25 * (q2x + q3x - q1x), 0.25 * (q2y + q3y - q1y), 0.25 * (q2z + q3z - q1z)
         c3x, c3y, c3z = 0.25 * (q2x - q1x - q3x), 0.25 * (q2y - q1y - q3y), 0.25 * (q2z - q1z - q3z)
-        xi = 0.0
-        eta = 0.0
+        # start: the projection on the face's mean plane (the parallelogram c0 + ξ c1 + η c2)
+        ex, ey, ez = px - c0x, py - c0y, pz - c0z
+        a11 = c1x * c1x + c1y * c1y + c1z * c1z
+        a22 = c2x * c2x + c2y * c2y + c2z * c2z
+        a12 = c1x * c2x + c1y * c2y + c1z * c2z
+        r1 = ex * c1x + ey * c1y + ez * c1z
+        r2 = ex * c2x + ey * c2y + ez * c2z
+        det = a11 * a22 - a12 * a12
+        xi = (a22 * r1 - a12 * r2) / det if det > 0.0 else 0.0
+        eta = (a11 * r2 - a12 * r1) / det if det > 0.0 else 0.0
+        step = abs(xi) + abs(eta)
+        if step > 2.0:  # far outside: from the centre
+            xi = 0.0
+            eta = 0.0
         ok = False
         for it in range(_NEWTON_ITERATIONS):
             t1x, t1y, t1z = c1x + eta * c3x, c1y + eta * c3y, c1z + eta * c3z

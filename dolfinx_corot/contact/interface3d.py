@@ -210,6 +210,19 @@ class Interface3D(Interface):
         global, f (k, 15), K (k, 15, 15), (slave, face) (k,)) over the pairs in contact."""
         xs, xm = self._positions(self.slave), self._positions(self.master)
         self._search(xs, xm)
+        self._x = (xs, xm)
+        if not self.comm.allreduce(len(self.candidates), op=MPI.SUM):  # nothing near: an idle interface
+            n = len(self.area)
+            self._assigned = (np.full(n, -1), np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64))
+            self.active[:] = -1
+            none = np.zeros(0, dtype=np.int64)
+            if self.first_evaluation:
+                self.first_evaluation, self.had_contact = False, False
+            self._virtual = None
+            self._last = (none, np.zeros(0))
+            self._forces = (none, none, np.zeros((0, PAIR_DOFS)))
+            return (np.zeros((0, PAIR_DOFS), dtype=np.int64), np.zeros((0, PAIR_DOFS)),
+                    np.zeros((0, PAIR_DOFS, PAIR_DOFS)), (none, none))
         self._assigned = self._assign(xs, xm, self.candidates)
         face, mode, which = self._assigned
         s = self.mine[face[self.mine] >= 0]

@@ -465,11 +465,8 @@ class Scene:
         for itf in self.interfaces:
             d = itf.describe()
             kind = "augmented Lagrangian" if itf.law.augmented else "penalty"
-            faces = isinstance(itf, Interface3D)
-            surface = ("flat master faces" if faces else
-                       "smooth master curve" if itf.smooth else "straight master segments")
             out.append(f"contact {itf.name}: {d['slave_nodes']} slave nodes on {d['master_segments']} "
-                       f"{'faces' if faces else 'segments'} ({kind}, penalty {itf.penalty:.3g}, {surface})")
+                       f"{itf.FACETS} ({kind}, penalty {itf.penalty:.3g}, {itf.master_surface})")
         out += [s.effect() for s in self.stabilisers]
         return out
 

@@ -21,3 +21,11 @@ def tangent_and_fd(system, values: np.ndarray, load_factor: float, h: float = 1e
         Kfd[:, j] = -(r[0] - r[1]) / (2 * h)
     values[:] = x0
     return K, Kfd
+
+
+def free_part(system, K: np.ndarray, Kfd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(K, K_fd) on the dofs that ``system`` does not constrain (its constrained columns are
+    eliminated from K, so only the free block compares)."""
+    fixed = np.concatenate([bc.dof_indices()[0] for bc in system.bcs])
+    free = np.setdiff1d(np.arange(len(K)), fixed)
+    return K[np.ix_(free, free)], Kfd[np.ix_(free, free)]

@@ -83,6 +83,7 @@ class Interface:
     (each a (part, boundary group name) pair). The symmetric (two-pass) contact of two
     deformable bodies is two interfaces, one each way."""
 
+    FACETS = "segments"  # what the master surface is made of (for Scene.effects)
     XI_TOLERANCE = 0.05  # beyond a free end of the master surface: this far (× length) still on it
     SMOOTH_ANGLE = np.radians(60.0)  # master vertices where the surface turns more than this stay sharp
     BAND_USES = 3  # corrections per Newton solve that may count lifted pairs as closed
@@ -98,14 +99,14 @@ class Interface:
         self.slave = slaves[0].model.surface(slaves[1], body=slaves[0].name or None)
         self.master = masters[0].model.surface(masters[1], body=masters[0].name or None)
         self.name = f"{slaves[1]} -> {masters[1]}"
-        # slaves: all nodes of the slave group; their tributary lengths on the slave boundary
-        self.area = _tributary_lengths(self.slave.X, self.slave.facets)
+        # slaves: all nodes of the slave group; their tributary lengths (areas) on the slave boundary
+        self.area = self._tributary(self.slave.X, self.slave.facets)
         Xm, sm = self.master.X, self.master.facets
         # beams: contact on either side of the axis, at half the section's depth from it
         self.two_sided = self.master.two_sided
         self.master_offset = self.master.offsets
         self.slave_face = self.slave.node_offsets()  # a beam's half depth at its slave nodes
-        self.h = float(np.mean(np.linalg.norm(Xm[sm[:, 1]] - Xm[sm[:, 0]], axis=1)))
+        self.h = float(np.mean(np.linalg.norm(Xm[sm] - Xm[np.roll(sm, -1, axis=1)], axis=2)))  # mean edge
         if law.penalty is not None:
             if not law.penalty > 0.0:
                 raise ValueError(f"contact '{self.name}': the penalty must be positive, got {law.penalty}")
@@ -116,11 +117,8 @@ class Interface:
                 raise ContactError(f"contact '{self.name}': between two beams the penalty has no solid to scale "
                                    "with: give it, e.g. dc.Penalty(penalty=...)")
             self.penalty = law.factor * min(moduli) / self.h
-        self.valence = np.bincount(sm.ravel(), minlength=len(Xm))  # segments at each master node
-        # nodes (p, a, b, q) of each segment's curve; p = a, q = b: the straight segment
         self.smooth = bool(smooth)
-        self.ext = (_smoothing_neighbours(Xm, sm, self.SMOOTH_ANGLE) if smooth
-                    else np.column_stack([sm[:, 0], sm[:, 0], sm[:, 1], sm[:, 1]]))
+        self._init_master()
         self.multiplier = np.zeros(len(self.area))
         self.margin = 0.5 * self.h
         # the interface's extent (its two surfaces' joint bounding box): no Newton correction
@@ -135,6 +133,24 @@ class Interface:
         self.exists = True  # (a stage may add or remove the interface)
         self.initial_gap = np.zeros(len(self.area))
         self.gap_cancelled = np.zeros(len(self.area), dtype=bool)
+
+    @property
+    def master_surface(self) -> str:
+        """The master surface the slaves meet, in words."""
+        return "smooth master curve" if self.smooth else "straight master segments"
+
+    @staticmethod
+    def _tributary(X: np.ndarray, facets: np.ndarray) -> np.ndarray:
+        """(n,) each node's share of the surface: its tributary length of the segments."""
+        return _tributary_lengths(X, facets)
+
+    def _init_master(self) -> None:
+        """What the search and the kernels need of the master segments: the segments at each
+        node, and the nodes (p, a, b, q) of each segment's curve (p = a, q = b: straight)."""
+        Xm, sm = self.master.X, self.master.facets
+        self.valence = np.bincount(sm.ravel(), minlength=len(Xm))
+        self.ext = (_smoothing_neighbours(Xm, sm, self.SMOOTH_ANGLE) if self.smooth
+                    else np.column_stack([sm[:, 0], sm[:, 0], sm[:, 1], sm[:, 1]]))
 
     # -- binding to a system ---------------------------------------------------------
     def bind(self, system) -> None:
@@ -555,10 +571,10 @@ class Interface:
         return True
 
     def pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
-        """Coordinates (n, 2) and contact pressure (n,) of all slave nodes of this pass, on every
-        rank, at the last evaluation: the nominal pressure ⟨λ − ε g⟩ per reference length with the
-        reference coordinates, or (``current``) the nodal force per current tributary length of the
-        slave surface (a beam's axis), with the current coordinates. In two-pass contact this is
+        """Coordinates (n, gdim) and contact pressure (n,) of all slave nodes of this pass, on every
+        rank, at the last evaluation: the nominal pressure ⟨λ − ε g⟩ per reference length (area)
+        with the reference coordinates, or (``current``) the nodal force per current tributary
+        length (area) of the slave surface (a beam's axis), with the current coordinates. In two-pass contact this is
         one pass's share; :meth:`ContactPair.pressure <dolfinx_corot.contact.ContactPair.pressure>`
         gives the interface pressure (both passes, on the actual contact face)."""
         s, g = self._last
@@ -569,7 +585,7 @@ class Interface:
         if not current:
             return self.slave.X, out
         x = self._positions(self.slave)
-        return x, out * self.area / _tributary_lengths(x, self.slave.facets)
+        return x, out * self.area / self._tributary(x, self.slave.facets)
 
     @property
     def contact_forces(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -61,64 +61,37 @@ class Interface3D(Interface):
     """One direction of 3D contact: the nodes of ``slaves`` against the faces of ``masters``
     (each a (part, boundary group name) pair)."""
 
+    FACETS = "faces"
+    master_surface = "flat master faces"
     INSIDE_TOLERANCE = 1e-9  # a projection this far (in the face's parameters) beyond an edge is on it
     FREE_EDGE_TOLERANCE = 0.05  # beyond an edge of the surface's border: this far (× the face) still on it
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = False):
-        if not isinstance(law, Penalty):
-            raise TypeError(f"contact law must be dc.Penalty or dc.AugmentedLagrangian, got {type(law).__name__}")
         if smooth:
             raise ContactError("3D contact: the smoothed master surface is not available yet; give smooth=False "
                                "(flat faces with edge and vertex contact)")
-        if slaves[0].model is masters[0].model and slaves[1] == masters[1]:
-            raise ContactError(f"contact of surface '{slaves[1]}' with itself is not supported: give two "
-                               "surfaces (self-contact is not implemented)")
-        self.slave_spec, self.master_spec, self.law = slaves, masters, law
-        self.slave = slaves[0].model.surface(slaves[1], body=slaves[0].name or None)
-        self.master = masters[0].model.surface(masters[1], body=masters[0].name or None)
-        for surf, spec in ((self.slave, slaves), (self.master, masters)):
+        super().__init__(slaves, masters, law, smooth)
+        self._virtual = None
+
+    def _init_master(self) -> None:
+        """The master faces padded to four nodes (a triangle's fourth is its first), the nodes of
+        each, and the edges (j, j + 1) of each face that border the surface (one face only): a
+        slave a little beyond them still meets the face, as in 2D beyond a free end."""
+        for surf, spec in ((self.slave, self.slave_spec), (self.master, self.master_spec)):
             if surf.dim != 2:
                 raise ContactError(f"3D contact: '{spec[1]}' of {spec[0].kind} '{spec[0].name}' is not a surface of "
                                    "faces (3D solids are supported so far)")
-        self.name = f"{slaves[1]} -> {masters[1]}"
-        self.area = tributary_areas(self.slave.X, self.slave.facets)
         faces = self.master.facets
         k = faces.shape[1]
         self.faces = np.hstack([faces, np.repeat(faces[:, :1], 4 - k, axis=1)]).astype(np.int64)
         self.nodes = np.full(len(faces), k, dtype=np.int64)
-        # the edges (j, j + 1) of each face that border the surface (one face only): a slave a little
-        # beyond them still meets the face, as in 2D beyond a free end
         pairs = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], axis=2), axis=2).reshape(-1, 2)
         _, inverse, count = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
         self.free_edge = (count[inverse] == 1).reshape(len(faces), k)
-        self.two_sided = self.master.two_sided
-        self.master_offset = self.master.offsets
-        self.slave_face = self.slave.node_offsets()
-        Xm = self.master.X
-        edges = np.linalg.norm(Xm[faces] - Xm[np.roll(faces, -1, axis=1)], axis=2)
-        self.h = float(edges.mean())
-        if law.penalty is not None:
-            if not law.penalty > 0.0:
-                raise ValueError(f"contact '{self.name}': the penalty must be positive, got {law.penalty}")
-            self.penalty = float(law.penalty)
-        else:
-            moduli = [surf.modulus for surf in (self.slave, self.master) if surf.modulus is not None]
-            if not moduli:
-                raise ContactError(f"contact '{self.name}': the penalty has no solid to scale with: give it, e.g. "
-                                   "dc.Penalty(penalty=...)")
-            self.penalty = law.factor * min(moduli) / self.h
-        self.smooth = False
-        self.multiplier = np.zeros(len(self.area))
-        self.margin = 0.5 * self.h
-        both = np.vstack([self.slave.X, Xm])
-        self.size = float(np.linalg.norm(both.max(axis=0) - both.min(axis=0)))
-        self.touch = 1e-6 * self.h
-        self.uzawa_updates = 0
-        self.slave_on = self.segment_on = None
-        self.exists = True
-        self.initial_gap = np.zeros(len(self.area))
-        self.gap_cancelled = np.zeros(len(self.area), dtype=bool)
-        self._virtual = None
+
+    @staticmethod
+    def _tributary(X: np.ndarray, facets: np.ndarray) -> np.ndarray:
+        return tributary_areas(X, facets)
 
     # -- pairs ------------------------------------------------------------------------------
     def pair_dofs(self, slaves: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -307,20 +280,6 @@ class Interface3D(Interface):
             u = (xs[free] - xm[v]) / np.maximum(dist, 1e-300)[:, None]
             worst = max(worst, self._ratio(ds[free] - dm[v], u, np.maximum(dist, self.margin), dist + self.margin))
         return worst
-
-    def pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
-        """Coordinates (n, 3) and nominal contact pressure ⟨λ − ε g⟩ (n,) of all slave nodes of this
-        pass, on every rank, at the last evaluation (``current``: the nodal force per current
-        tributary area, with the current coordinates)."""
-        s, g = self._last
-        p = np.zeros(len(self.area))
-        p[s] = np.maximum(0.0, self.multiplier[s] - self.penalty * g)
-        out = np.zeros_like(p)
-        self.comm.Allreduce(p, out, op=MPI.SUM)
-        if not current:
-            return self.slave.X, out
-        x = self._positions(self.slave)
-        return x, out * self.area / tributary_areas(x, self.slave.facets)
 
     def nodal_forces(self, on_slaves: bool) -> np.ndarray:
         """(n, 3) the contact shares of the internal forces of this pass on the nodes of the slave

@@ -141,6 +141,64 @@ def _sort_keys(keys):
 
 
 @numba.njit(cache=True)
+def _column_table(skeys, ncol, stride, ns):
+    """(dense, colstart): the start in sorted order of each column of cell keys ``col · stride + i``
+    when the table is affordable (ncol ≤ 4 ns + 64); otherwise columns are found by binary
+    search over all slaves (dense False, an empty table)."""
+    dense = ncol <= 4 * ns + 64
+    if not dense:
+        return dense, np.empty(0, dtype=np.int64)
+    colstart = np.empty(ncol + 1, dtype=np.int64)
+    k = 0
+    for c in range(ncol + 1):
+        while k < ns and skeys[k] < c * stride:
+            k += 1
+        colstart[c] = k
+    return dense, colstart
+
+
+@numba.njit(cache=True)
+def _column_range(skeys, dense, colstart, col, stride, lo, hi, ns):
+    """(k0, k1): the sorted positions of the slaves of column ``col`` in cells lo … hi."""
+    c0 = colstart[col] if dense else 0
+    c1 = colstart[col + 1] if dense else ns
+    k0 = _lower_bound(skeys, c0, c1, col * stride + lo)
+    return k0, _lower_bound(skeys, k0, c1, col * stride + hi + 1)
+
+
+@numba.njit(cache=True)
+def _reserve(buf_k, buf_m, npairs, extra):
+    """The pair buffers, grown (doubled at least) when ``extra`` more pairs would not fit."""
+    if npairs + extra <= buf_k.shape[0]:
+        return buf_k, buf_m
+    cap = max(2 * buf_k.shape[0], npairs + extra)
+    nb_k = np.empty(cap, dtype=np.int64)
+    nb_m = np.empty(cap, dtype=np.int64)
+    nb_k[:npairs] = buf_k[:npairs]
+    nb_m[:npairs] = buf_m[:npairs]
+    return nb_k, nb_m
+
+
+@numba.njit(cache=True)
+def _pairs_by_slave(order, buf_k, buf_m, npairs, ns):
+    """(npairs, 2) [slave, master] from the buffers (slave positions in sorted order, masters
+    produced in increasing order), by a counting sort on the slave: lexicographic."""
+    count = np.zeros(ns + 1, dtype=np.int64)
+    for p in range(npairs):
+        count[order[buf_k[p]] + 1] += 1
+    for i in range(ns):
+        count[i + 1] += count[i]
+    pairs = np.empty((npairs, 2), dtype=np.int64)
+    for p in range(npairs):
+        s = order[buf_k[p]]
+        q = count[s]
+        count[s] = q + 1
+        pairs[q, 0] = s
+        pairs[q, 1] = buf_m[p]
+    return pairs
+
+
+@numba.njit(cache=True)
 def _broad_phase_kernel(slaves, seg_a, seg_b, margin):
     ns = slaves.shape[0]
     nm = seg_a.shape[0]
@@ -191,18 +249,7 @@ def _broad_phase_kernel(slaves, seg_a, seg_b, margin):
         i = order[k]
         sxy[k, 0] = slaves[i, 0]
         sxy[k, 1] = slaves[i, 1]
-    # column table (start of each column in sorted order) when affordable;
-    # otherwise columns are found by binary search over all slaves
-    dense = nx <= 4 * ns + 64
-    if dense:
-        colstart = np.empty(nx + 1, dtype=np.int64)
-        k = 0
-        for c in range(nx + 1):
-            while k < ns and skeys[k] < c * ny:
-                k += 1
-            colstart[c] = k
-    else:
-        colstart = np.empty(0, dtype=np.int64)
+    dense, colstart = _column_table(skeys, nx, ny, ns)
 
     # segments in increasing index: visit the columns of their box; the box
     # test is branch-free (write always, advance the counter when inside)
@@ -230,22 +277,8 @@ def _broad_phase_kernel(slaves, seg_a, seg_b, margin):
         iy0 = math.floor((l1 - ymin) / h)
         iy1 = math.floor((u1 - ymin) / h)
         for ix in range(ix0, ix1 + 1):
-            if dense:
-                c0 = colstart[ix]
-                c1 = colstart[ix + 1]
-            else:
-                c0 = 0
-                c1 = ns
-            k0 = _lower_bound(skeys, c0, c1, ix * ny + iy0)
-            k1 = _lower_bound(skeys, k0, c1, ix * ny + iy1 + 1)
-            if npairs + (k1 - k0) > cap:
-                cap = max(2 * cap, npairs + (k1 - k0))
-                nb_k = np.empty(cap, dtype=np.int64)
-                nb_m = np.empty(cap, dtype=np.int64)
-                nb_k[:npairs] = buf_k[:npairs]
-                nb_m[:npairs] = buf_m[:npairs]
-                buf_k = nb_k
-                buf_m = nb_m
+            k0, k1 = _column_range(skeys, dense, colstart, ix, ny, iy0, iy1, ns)
+            buf_k, buf_m = _reserve(buf_k, buf_m, npairs, k1 - k0)
             for k in range(k0, k1):
                 x = sxy[k, 0]
                 y = sxy[k, 1]
@@ -253,21 +286,8 @@ def _broad_phase_kernel(slaves, seg_a, seg_b, margin):
                 buf_m[npairs] = j
                 npairs += (xlo <= x) & (x <= xhi) & (ylo <= y) & (y <= yhi)
 
-    # counting sort by slave; segments were produced in increasing order, so
-    # each slave's list stays sorted and the result is lexicographic
-    count = np.zeros(ns + 1, dtype=np.int64)
-    for p in range(npairs):
-        count[order[buf_k[p]] + 1] += 1
-    for i in range(ns):
-        count[i + 1] += count[i]
-    pairs = np.empty((npairs, 2), dtype=np.int64)
-    for p in range(npairs):
-        s = order[buf_k[p]]
-        q = count[s]
-        count[s] = q + 1
-        pairs[q, 0] = s
-        pairs[q, 1] = buf_m[p]
-    return pairs
+    # segments were produced in increasing order: each slave's list stays sorted
+    return _pairs_by_slave(order, buf_k, buf_m, npairs, ns)
 
 
 @numba.njit(cache=True)

@@ -27,7 +27,7 @@ import math
 import numba
 import numpy as np
 
-from .search import _lower_bound, _sort_keys
+from .search import _column_range, _column_table, _pairs_by_slave, _reserve, _sort_keys
 
 __all__ = ["broad_phase_boxes", "face_boxes"]
 
@@ -72,18 +72,7 @@ def _broad_phase_kernel(slaves, lo, hi):
     for k in range(ns):
         for d in range(3):
             sx[k, d] = slaves[order[k], d]
-    # column table ((ix, iy) → start in sorted order) when affordable
-    ncol = nx * ny
-    dense = ncol <= 4 * ns + 64
-    if dense:
-        colstart = np.empty(ncol + 1, dtype=np.int64)
-        k = 0
-        for c in range(ncol + 1):
-            while k < ns and skeys[k] < c * nz:
-                k += 1
-            colstart[c] = k
-    else:
-        colstart = np.empty(0, dtype=np.int64)
+    dense, colstart = _column_table(skeys, nx * ny, nz, ns)  # columns (ix, iy)
     cap = max(16, 4 * (ns + nm))
     buf_k = np.empty(cap, dtype=np.int64)
     buf_m = np.empty(cap, dtype=np.int64)
@@ -105,42 +94,15 @@ def _broad_phase_kernel(slaves, lo, hi):
         iz1 = math.floor((u2 - smin[2]) / h)
         for ix in range(ix0, ix1 + 1):
             for iy in range(iy0, iy1 + 1):
-                col = ix * ny + iy
-                if dense:
-                    c0 = colstart[col]
-                    c1 = colstart[col + 1]
-                else:
-                    c0 = 0
-                    c1 = ns
-                k0 = _lower_bound(skeys, c0, c1, col * nz + iz0)
-                k1 = _lower_bound(skeys, k0, c1, col * nz + iz1 + 1)
-                if npairs + (k1 - k0) > cap:
-                    cap = max(2 * cap, npairs + (k1 - k0))
-                    nb_k = np.empty(cap, dtype=np.int64)
-                    nb_m = np.empty(cap, dtype=np.int64)
-                    nb_k[:npairs] = buf_k[:npairs]
-                    nb_m[:npairs] = buf_m[:npairs]
-                    buf_k = nb_k
-                    buf_m = nb_m
+                k0, k1 = _column_range(skeys, dense, colstart, ix * ny + iy, nz, iz0, iz1, ns)
+                buf_k, buf_m = _reserve(buf_k, buf_m, npairs, k1 - k0)
                 for k in range(k0, k1):
                     buf_k[npairs] = k
                     buf_m[npairs] = j
                     npairs += ((lo[j, 0] <= sx[k, 0]) & (sx[k, 0] <= hi[j, 0]) & (lo[j, 1] <= sx[k, 1])
                                & (sx[k, 1] <= hi[j, 1]) & (lo[j, 2] <= sx[k, 2]) & (sx[k, 2] <= hi[j, 2]))
-    # counting sort by slave (faces were visited in increasing order: lexicographic result)
-    count = np.zeros(ns + 1, dtype=np.int64)
-    for p in range(npairs):
-        count[order[buf_k[p]] + 1] += 1
-    for i in range(ns):
-        count[i + 1] += count[i]
-    pairs = np.empty((npairs, 2), dtype=np.int64)
-    for p in range(npairs):
-        s = order[buf_k[p]]
-        q = count[s]
-        count[s] = q + 1
-        pairs[q, 0] = s
-        pairs[q, 1] = buf_m[p]
-    return pairs
+    # faces were visited in increasing order: each slave's list stays sorted
+    return _pairs_by_slave(order, buf_k, buf_m, npairs, ns)
 
 
 def face_boxes(x: np.ndarray, faces: np.ndarray, margin) -> tuple[np.ndarray, np.ndarray]:

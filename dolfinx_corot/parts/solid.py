@@ -625,37 +625,39 @@ class Solid(AdditiveState, Part):
 
     # -- contact surface -------------------------------------------------------------
     def surface(self, where: str, body: str | None = None) -> Surface:
-        """The boundary lines of facet group ``where`` of a linear 2D solid, oriented with the body on
-        the left; its stiffness scale is the smallest plane-strain modulus E/(1 − ν²) of the solid.
-        ``body`` (a cell group): a line between a cell of ``body`` and one of another region is the
-        face of the ``body`` cell (e.g. a fill's face along a structure, on cells excavated before
-        the fill appears); lines with cells of the solid on both sides otherwise are refused."""
-        if self.gdim == 3:
-            return self._surface_3d(where, body)
-        if self.gdim != 2:
+        """The boundary facets of facet group ``where`` of a linear solid, oriented out of the body:
+        in 2D lines with the body on their left, in 3D faces (triangles of tetrahedra,
+        quadrilaterals of hexahedra) with their nodes counter-clockwise seen from outside (the
+        normal (x₂ − x₁) × (x₃ − x₁) points out of the body); its stiffness scale is the smallest
+        E/(1 − ν²) of the solid. ``body`` (a cell group): a facet between a cell of ``body`` and one
+        of another region is the face of the ``body`` cell (e.g. a fill's face along a structure,
+        on cells excavated before the fill appears); facets with cells of the solid on both sides
+        otherwise are refused."""
+        if self.gdim not in (2, 3):
             return super().surface(where, body)
+        kind = "node-to-segment" if self.gdim == 2 else "node-to-face"
         if self.degree != 1:
-            raise SurfaceError(f"contact surface '{where}': node-to-segment contact needs linear solids "
-                               f"(degree 1); this solid has degree {self.degree}")
+            raise SurfaceError(f"contact surface '{where}': {kind} contact needs linear solids (degree 1); this "
+                               f"solid has degree {self.degree}")
+        lines = "lines" if self.gdim == 2 else "faces"
         tm = self.tmesh
         facets = tm.facets(where)
         if facets is None:
-            raise SurfaceError(f"contact surface '{where}' is not a group of boundary lines of the solid mesh "
+            raise SurfaceError(f"contact surface '{where}' is not a group of boundary {lines} of the solid mesh "
                                f"(groups: {sorted(tm.groups)})")
         mesh = tm.mesh
-        mesh.topology.create_connectivity(1, 2)
-        mesh.topology.create_connectivity(1, 0)
-        f2c = mesh.topology.connectivity(1, 2)
-        f2v = mesh.topology.connectivity(1, 0)
-        c2v = mesh.topology.connectivity(2, 0)
-        n_owned_cells = mesh.topology.index_map(2).size_local
-        Xdof = self.V.tabulate_dof_coordinates()[:, :2]
+        tdim = self.tdim
+        mesh.topology.create_connectivity(tdim - 1, tdim)
+        mesh.topology.create_connectivity(tdim - 1, 0)
+        f2c, f2v = mesh.topology.connectivity(tdim - 1, tdim), mesh.topology.connectivity(tdim - 1, 0)
+        c2v = mesh.topology.connectivity(tdim, 0)
+        cmap = mesh.topology.index_map(tdim)
+        Xdof = self.V.tabulate_dof_coordinates()[:, : self.gdim]
         in_body = None
         if body:
-            in_body = np.zeros(mesh.topology.index_map(2).size_local + mesh.topology.index_map(2).num_ghosts,
-                               dtype=bool)
+            in_body = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
             in_body[tm.cells(body)] = True
-        seg_blocks, seg_cells, inner = [], [], 0
+        facet_blocks, facet_cells, inner = [], [], 0
         for f in facets:
             cells = f2c.links(f)
             if len(cells) == 2 and in_body is not None and in_body[cells].sum() == 1:
@@ -664,85 +666,40 @@ class Solid(AdditiveState, Part):
                 inner += 1
                 continue
             c = cells[0]
-            if c >= n_owned_cells:
+            if c >= cmap.size_local:
                 continue  # the owner of the cell adds this facet
             cv = list(c2v.links(c))
             cd = self.V.dofmap.cell_dofs(c)
-            a, b = (cd[cv.index(v)] for v in f2v.links(f))
-            centroid = Xdof[cd].mean(axis=0)
-            t = Xdof[b] - Xdof[a]
-            n = np.array([t[1], -t[0]])
-            if np.dot(0.5 * (Xdof[a] + Xdof[b]) - centroid, n) < 0.0:
-                a, b = b, a  # the body on the left of a -> b
-            seg_blocks.append((a, b))
-            seg_cells.append(c)
+            nodes = np.array([cd[cv.index(v)] for v in f2v.links(f)])
+            facet_blocks.append(_outward(nodes, Xdof, Xdof[cd].mean(axis=0)))
+            facet_cells.append(c)
         if self.comm.allreduce(inner, op=MPI.SUM):  # raised on every rank
             side = f" (between two cells of '{body}' or of other regions)" if body else ""
-            raise SurfaceError(f"contact surface '{where}': some of its lines lie inside the solid{side}, "
+            raise SurfaceError(f"contact surface '{where}': some of its {lines} lie inside the solid{side}, "
                                "not on its boundary")
-        return gather_surface(self, where, np.array(seg_blocks, dtype=np.int64).reshape(-1, 2), Xdof,
-                              modulus=self._contact_modulus(), cells=np.array(seg_cells, dtype=np.int32))
+        nv = {"triangle": 2, "quadrilateral": 2, "tetrahedron": 3, "hexahedron": 4}[mesh.topology.cell_name()]
+        return gather_surface(self, where, np.array(facet_blocks, dtype=np.int64).reshape(-1, nv), Xdof,
+                              modulus=self._contact_modulus(), cells=np.array(facet_cells, dtype=np.int32))
 
     def _contact_modulus(self) -> float:
         """The smallest E/(1 − ν²) of the solid's materials: the stiffness scale of a default penalty."""
         E, nu = self.E.x.array, self.nu.x.array
         return self.comm.allreduce(float(np.min(E / (1.0 - nu**2))) if len(E) else np.inf, op=MPI.MIN)
 
-    def _surface_3d(self, where: str, body: str | None) -> Surface:
-        """The boundary faces of facet group ``where`` of a linear 3D solid (triangles of tetrahedra,
-        quadrilaterals of hexahedra), their nodes counter-clockwise seen from outside (the normal
-        (x₂ − x₁) × (x₃ − x₁) points out of the body); ``body`` as in 2D."""
-        if self.degree != 1:
-            raise SurfaceError(f"contact surface '{where}': node-to-face contact needs linear solids (degree 1); "
-                               f"this solid has degree {self.degree}")
-        tm = self.tmesh
-        facets = tm.facets(where)
-        if facets is None:
-            raise SurfaceError(f"contact surface '{where}' is not a group of boundary faces of the solid mesh "
-                               f"(groups: {sorted(tm.groups)})")
-        mesh = tm.mesh
-        mesh.topology.create_connectivity(2, 3)
-        mesh.topology.create_connectivity(2, 0)
-        f2c, f2v = mesh.topology.connectivity(2, 3), mesh.topology.connectivity(2, 0)
-        c2v = mesh.topology.connectivity(3, 0)
-        n_owned_cells = mesh.topology.index_map(3).size_local
-        Xdof = self.V.tabulate_dof_coordinates()
-        in_body = None
-        if body:
-            cmap = mesh.topology.index_map(3)
-            in_body = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
-            in_body[tm.cells(body)] = True
-        face_blocks, face_cells, inner = [], [], 0
-        for f in facets:
-            cells = f2c.links(f)
-            if len(cells) == 2 and in_body is not None and in_body[cells].sum() == 1:
-                cells = cells[in_body[cells]]
-            if len(cells) != 1:
-                inner += 1
-                continue
-            c = cells[0]
-            if c >= n_owned_cells:
-                continue  # the owner of the cell adds this face
-            cv = list(c2v.links(c))
-            cd = self.V.dofmap.cell_dofs(c)
-            nodes = np.array([cd[cv.index(v)] for v in f2v.links(f)])
-            x = Xdof[nodes]
-            centre = x.mean(axis=0)
-            if len(nodes) == 4:  # the quadrilateral's corners in cyclic order around its centre
-                normal = np.cross(x[1] - x[0], x[2] - x[0])
-                e1 = x[0] - centre
-                e1 /= np.linalg.norm(e1)
-                e2 = np.cross(normal / np.linalg.norm(normal), e1)
-                nodes = nodes[np.argsort(np.arctan2((x - centre) @ e2, (x - centre) @ e1))]
-                x = Xdof[nodes]
-            if np.dot(np.cross(x[1] - x[0], x[2] - x[0]), centre - Xdof[cd].mean(axis=0)) < 0.0:
-                nodes = nodes[::-1]  # counter-clockwise seen from outside
-            face_blocks.append(nodes)
-            face_cells.append(c)
-        if self.comm.allreduce(inner, op=MPI.SUM):
-            side = f" (between two cells of '{body}' or of other regions)" if body else ""
-            raise SurfaceError(f"contact surface '{where}': some of its faces lie inside the solid{side}, "
-                               "not on its boundary")
-        nv = 4 if mesh.topology.cell_name() == "hexahedron" else 3
-        return gather_surface(self, where, np.array(face_blocks, dtype=np.int64).reshape(-1, nv), Xdof,
-                              modulus=self._contact_modulus(), cells=np.array(face_cells, dtype=np.int32))
+
+def _outward(nodes: np.ndarray, X: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """The boundary facet ``nodes`` (blocks of X) of the cell of centre ``centre`` ordered out of
+    the cell: a segment (a, b) with the cell on its left; a face counter-clockwise seen from
+    outside (a quadrilateral's corners first put in cyclic order around its centre)."""
+    x = X[nodes]
+    mid = x.mean(axis=0)
+    if len(nodes) == 2:
+        t = x[1] - x[0]
+        return nodes if np.dot(mid - centre, [t[1], -t[0]]) >= 0.0 else nodes[::-1]
+    if len(nodes) == 4:
+        normal = np.cross(x[1] - x[0], x[2] - x[0])
+        e1 = (x[0] - mid) / np.linalg.norm(x[0] - mid)
+        e2 = np.cross(normal / np.linalg.norm(normal), e1)
+        nodes = nodes[np.argsort(np.arctan2((x - mid) @ e2, (x - mid) @ e1))]
+        x = X[nodes]
+    return nodes if np.dot(np.cross(x[1] - x[0], x[2] - x[0]), mid - centre) >= 0.0 else nodes[::-1]

@@ -108,4 +108,5 @@ def gather_surface(part, name: str, facet_blocks: np.ndarray, Xdof: np.ndarray, 
     local_offsets = extra.pop("offsets", np.zeros(len(facet_blocks)))
     extra["cells"] = np.asarray(extra.get("cells", np.zeros(len(facet_blocks))), dtype=np.int32)
     offsets = np.concatenate(comm.allgather(np.asarray(local_offsets, dtype=float)))
-    return Surface(part, name, gdim - 1, keys, X, facets, own_pos, own_blocks.astype(np.int32), offsets, **extra)
+    dim = 1 if nv == 2 else 2  # segments, or faces (triangles and quadrilaterals)
+    return Surface(part, name, dim, keys, X, facets, own_pos, own_blocks.astype(np.int32), offsets, **extra)

@@ -20,7 +20,7 @@ from .materials import Elastic, NeoHookean, SaintVenantKirchhoff
 from .parts import MeshError
 from .result import History, Result
 from .scene import Scene
-from .sections import Circle, Rectangle, Section
+from .sections import Circle, Pipe, Rectangle, Section
 from .solvers import (ArcLength, CheckpointError, ConvergenceError, CriticalPoint, CriticalPointError, LoadControl,
                       NewtonOptions, SingularModelError, solve)
 
@@ -28,5 +28,5 @@ __version__ = "0.1.0"
 
 __all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "ContactPair", "Penalty", "Circle", "ConvergenceError", "CriticalPoint",
            "CriticalPointError", "SingularModelError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
-           "MeshError", "NeoHookean", "NewtonOptions", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
+           "MeshError", "NeoHookean", "NewtonOptions", "Pipe", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
            "rotations", "solve"]

@@ -307,10 +307,13 @@ class Scene:
 
     def contact(self, slaves: tuple[PartRef, str], masters: tuple[PartRef, str], law=None,
                 symmetric: bool = False, smooth: bool | None = None) -> list:
-        """Frictionless node-to-segment (2D) or node-to-face (3D: faces of linear tetrahedra and
-        hexahedra) contact of the nodes of boundary group ``slaves[1]`` of part ``slaves[0]``
-        against the boundary segments or faces of ``masters``; ``symmetric`` adds the other
-        direction (two-pass contact, for two deformable bodies).
+        """Frictionless node-to-segment (2D) or node-to-face (3D) contact of the nodes of group
+        ``slaves[1]`` of part ``slaves[0]`` against the segments or faces of ``masters``;
+        ``symmetric`` adds the other direction (two-pass contact, for two deformable bodies).
+        In 3D the surfaces are boundary face groups of linear solids (tetrahedra, hexahedra),
+        cell groups of shells and membranes (two-sided: their faces at ±t/2 from the
+        mid-surface), and, as slaves only, line groups of beams (their nodes meet faces at the
+        section's outer radius, ``Section.outer``; solid–beam contact is one-pass).
 
         law: dc.Penalty() (default) or dc.AugmentedLagrangian(); the default penalty scales with
         the bodies' stiffness and the master segments' length.

@@ -146,7 +146,7 @@ def test_assembled_3d_contact_tangent_matches_finite_differences(symmetric):
 
 def test_3d_contact_input_is_checked_by_name():
     """Refused by name: a group that is not a face group of the solid, the smoothed master (not yet
-    in 3D), a quadratic solid, and a 3D beam (not yet a 3D contact surface)."""
+    in 3D), a quadratic solid, and a 3D beam as the master (a beam meets faces by its nodes)."""
     from dolfinx_corot.io.gmsh_models import polyline
 
     tm = _two_blocks(0.5, 0.5)
@@ -158,9 +158,12 @@ def test_3d_contact_input_is_checked_by_name():
         sc.contact((b, "upper_face"), (b, "lower"))
     beam = sc.add_beam(polyline([[0.2, 0.2, 0.9], [0.8, 0.2, 0.9]], 2, gdim=3), "beam", section=dc.Rectangle(0.1, 0.1),
                        material=dc.Elastic(E, NU), orientation=(0.0, 0.0, 1.0))
-    with pytest.raises(ValueError, match="contact surface 'beam': structural parts in 3D are not supported as "
-                                         "contact surfaces so far"):
-        sc.contact((beam, "beam"), (b, "lower_face"))
+    with pytest.raises(dc.ContactError, match="the master 'beam' of beam 'beam' is a line, not a surface of faces: "
+                                              "a 3D beam meets solids and shells by its nodes"):
+        sc.contact((b, "upper_face"), (beam, "beam"))
+    with pytest.raises(dc.ContactError, match="solid–beam contact is one-pass"):
+        sc.contact((beam, "beam"), (b, "lower_face"), symmetric=True)
+    assert len(sc.contact((beam, "beam"), (b, "lower_face"))) == 1
     quadratic = dc.Scene(large_rotations=False).add_solid(tm, material=dc.Elastic(E, NU), degree=2)
     with pytest.raises(ValueError, match="contact surface 'upper_face': node-to-face contact needs linear solids"):
         quadratic.model.surface("upper_face")

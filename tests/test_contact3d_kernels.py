@@ -18,10 +18,10 @@ def _face(k: int, rng) -> np.ndarray:
     return face + rng.normal(0.0, 0.02, face.shape)
 
 
-def _evaluate(x, k, mode, which, offset, lam, tangent=False):
+def _evaluate(x, k, mode, which, offset, lam, tangent=False, side=0.0):
     m = 3 * (1 + k)
     f, K = np.zeros(m), np.zeros((m, m))
-    g = k3.node_to_face(x, k, mode, which, offset, lam, EPS, AREA, tangent, f, K)
+    g = k3.node_to_face(x, k, mode, which, side, offset, lam, EPS, AREA, tangent, f, K)
     return g, f, K
 
 
@@ -30,17 +30,10 @@ CASES = [(0, 0, [0.3, 0.35, -0.02]), (1, 0, [0.5, -0.2, -0.03]), (1, 1, [0.9, 0.
          (2, 1, [1.3, -0.2, -0.05]), (2, 0, [-0.2, -0.2, -0.01])]
 
 
-@pytest.mark.parametrize("k", [3, 4])
-@pytest.mark.parametrize("mode, which, slave", CASES)
-@pytest.mark.parametrize("offset, lam", [(0.0, 0.0), (0.05, 0.0), (0.0, 3.0)])
-def test_force_is_the_energy_gradient_and_the_tangent_its_derivative(k, mode, which, slave, offset, lam):
-    """Face interior, edge and vertex contact of a slave against a triangle and a warped bilinear
-    quadrilateral, with an offset (a shell's half thickness) and an augmented-Lagrangian
-    multiplier: f = ∂W/∂x and K = ∂f/∂x by central differences (h = 1e-6: 1e-8 of the largest
-    entry), K symmetric (the Hessian of W: 1e-12)."""
-    rng = np.random.default_rng(11)
-    x = np.vstack([slave, _face(k, rng)])
-    g, f, K = _evaluate(x, k, mode, which, offset, lam, tangent=True)
+def _check_derivatives(x, k, mode, which, offset, lam, side=0.0):
+    """f = ∂W/∂x and K = ∂f/∂x by central differences (h = 1e-6: 1e-8 of the largest entry), K
+    symmetric (the Hessian of W: 1e-12), the pair's forces in balance (1e-13)."""
+    g, f, K = _evaluate(x, k, mode, which, offset, lam, tangent=True, side=side)
     assert lam - EPS * g > 0.0  # in contact
     m = 3 * (1 + k)
     h = 1e-6
@@ -50,7 +43,8 @@ def test_force_is_the_energy_gradient_and_the_tangent_its_derivative(k, mode, wh
         xp, xm = x.copy(), x.copy()
         xp.flat[j] += h
         xm.flat[j] -= h
-        (gp, fp, _), (gm, fm, _) = _evaluate(xp, k, mode, which, offset, lam), _evaluate(xm, k, mode, which, offset, lam)
+        (gp, fp, _) = _evaluate(xp, k, mode, which, offset, lam, side=side)
+        (gm, fm, _) = _evaluate(xm, k, mode, which, offset, lam, side=side)
         fd_f[j] = (energy(gp) - energy(gm)) / (2 * h)
         fd_K[:, j] = (fp - fm) / (2 * h)
     assert np.abs(f - fd_f).max() < 1e-8 * np.abs(f).max()
@@ -58,6 +52,39 @@ def test_force_is_the_energy_gradient_and_the_tangent_its_derivative(k, mode, wh
     assert np.abs(K - K.T).max() < 1e-12 * np.abs(K).max()
     # the slave's force balances the face nodes' (no net force along any axis)
     assert np.abs(f.reshape(-1, 3).sum(axis=0)).max() < 1e-13 * np.abs(f).max()
+    return g, f
+
+
+@pytest.mark.parametrize("k", [3, 4])
+@pytest.mark.parametrize("mode, which, slave", CASES)
+@pytest.mark.parametrize("offset, lam", [(0.0, 0.0), (0.05, 0.0), (0.0, 3.0)])
+def test_force_is_the_energy_gradient_and_the_tangent_its_derivative(k, mode, which, slave, offset, lam):
+    """Face interior, edge and vertex contact of a slave against a triangle and a warped bilinear
+    quadrilateral, with an offset (a beam slave's radius) and an augmented-Lagrangian
+    multiplier."""
+    rng = np.random.default_rng(11)
+    _check_derivatives(np.vstack([slave, _face(k, rng)]), k, mode, which, offset, lam)
+
+
+@pytest.mark.parametrize("k", [3, 4])
+@pytest.mark.parametrize("mode, which, slave", CASES)
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_two_sided_master_with_a_shell_offset(k, mode, which, slave, side):
+    """A shell's mid-surface as a two-sided master, its contact faces at ±t/2 (offset 0.4): a
+    slave 0.03 from the mid-surface on either side, over the face, beyond an edge and beyond a
+    vertex, is pushed away from the mid-surface on its own side: over the face along ± the face
+    normal, at an edge or vertex away from its nearest point (a shell's free edge is rounded);
+    f and K are the derivatives of the energy as above."""
+    rng = np.random.default_rng(11)
+    x = np.vstack([[slave[0], slave[1], 0.03 * side], _face(k, rng)])
+    g, f = _check_derivatives(x, k, mode, which, 0.4, 0.0, side=side)
+    assert g < 0.0
+    N, n = np.zeros(k), np.zeros(3)
+    dist = k3._contact_point(x, k, mode, which, side, N, n)
+    assert dist > 0.0 and dist == pytest.approx(g + 0.4, abs=1e-14)
+    xc = N @ x[1:]
+    assert np.allclose(n, (x[0] - xc) / np.linalg.norm(x[0] - xc), atol=1e-12)  # towards the slave
+    assert np.allclose(f[:3], -AREA * EPS * (-g) * n, atol=1e-12)  # the push on the slave is +p A n
 
 
 @pytest.mark.parametrize("k", [3, 4])

@@ -41,7 +41,7 @@ from .search import broad_phase, narrow_phase
 logger = logging.getLogger(__name__)
 
 
-def _tributary_lengths(X: np.ndarray, segments: np.ndarray) -> np.ndarray:
+def tributary_lengths(X: np.ndarray, segments: np.ndarray) -> np.ndarray:
     """Half the summed lengths of the segments at each node (the node's share of the boundary)."""
     length = np.linalg.norm(X[segments[:, 1]] - X[segments[:, 0]], axis=1)
     out = np.zeros(len(X))
@@ -142,7 +142,7 @@ class Interface:
     @staticmethod
     def _tributary(X: np.ndarray, facets: np.ndarray) -> np.ndarray:
         """(n,) each node's share of the surface: its tributary length of the segments."""
-        return _tributary_lengths(X, facets)
+        return tributary_lengths(X, facets)
 
     def _init_master(self) -> None:
         """What the search and the kernels need of the master segments: the segments at each
@@ -172,6 +172,13 @@ class Interface:
         self.band_used = 0
         self._virtual = None
         self._update_existence()
+
+    def kept_state(self):
+        """What a cut step restores besides the multipliers (none in 2D)."""
+        return None
+
+    def restore_kept(self, state) -> None:
+        pass
 
     @property
     def slave_offset(self) -> np.ndarray:
@@ -605,7 +612,7 @@ class Interface:
             np.add.at(force, self.ext[m, j], f[:, 2 * j + 2:2 * j + 4])
         total = np.zeros_like(force)
         self.comm.Allreduce(force, total, op=MPI.SUM)
-        length = _tributary_lengths(self.master.X, seg)
+        length = tributary_lengths(self.master.X, seg)
         x = self._positions(self.master) if current else self.master.X
         return x, np.linalg.norm(total, axis=1) / length
 
@@ -760,11 +767,12 @@ class Contact(Contribution):
 
     # -- state ------------------------------------------------------------------------
     def checkpoint(self):
-        return [itf.multiplier.copy() for itf in self.interfaces]
+        return [(itf.multiplier.copy(), itf.kept_state()) for itf in self.interfaces]
 
     def restore(self, state) -> None:
-        for itf, lam in zip(self.interfaces, state):
+        for itf, (lam, kept) in zip(self.interfaces, state):
             itf.multiplier[:] = lam
+            itf.restore_kept(kept)
 
     def state_arrays(self) -> dict:
         """Multipliers, candidate pairs (all ranks') and the positions of the last search."""
@@ -775,6 +783,11 @@ class Contact(Contribution):
             out[f"{k}_gap_cancelled"] = itf.gap_cancelled.astype(float)
             cand = np.concatenate(self.comm.allgather(itf.candidates)).reshape(-1, 2)
             out[f"{k}_candidates"] = np.unique(cand, axis=0)
+            kept = itf.kept_state()
+            if kept is not None:  # each rank's own slaves' faces
+                mine = np.full(len(kept), -1)
+                mine[itf.mine] = kept[itf.mine]
+                out[f"{k}_kept"] = self.comm.allreduce(mine, op=MPI.MAX).astype(float)
             if itf.anchor is not None:
                 out[f"{k}_anchor_slave"], out[f"{k}_anchor_master"] = itf.anchor
         return out
@@ -792,6 +805,8 @@ class Contact(Contribution):
             cand = arrays[f"{k}_candidates"].astype(np.int64).reshape(-1, 2)
             itf.candidates = cand[np.isin(cand[:, 0], itf.mine)]
             itf.pairs_changed = True
+            if f"{k}_kept" in arrays:
+                itf.restore_kept(arrays[f"{k}_kept"].astype(np.int64))
             if f"{k}_anchor_slave" in arrays:
                 itf.anchor = (arrays[f"{k}_anchor_slave"].copy(), arrays[f"{k}_anchor_master"].copy())
 

@@ -10,16 +10,25 @@ evaluates the slaves whose x dof it owns. At each evaluation
    a slave has moved by half the margin since the last search (the pattern of the contact
    matrix is rebuilt only then);
 2. each slave takes, among its candidate faces, the one onto which its closest point falls (within
-   a small tolerance beyond the edges) with the smallest |g|, chosen afresh at every evaluation: a
-   slave may change master face at any iteration. A slave that falls onto no face but lies
-   within the margin of a convex edge or vertex of one (beyond the faces on both sides) meets that
-   edge or vertex (:mod:`.kernels3d`, modes 1 and 2): crossing from face to edge to face the
-   contact point and the gap are continuous;
+   round-off beyond the edges; a solid's slave also a little beyond the surface's border): the
+   face it had at the last evaluation while it still falls onto it, else the one with the
+   smallest |g|. A slave may change master face at any iteration; keeping the face where the
+   slave's projection falls onto two (in the groove of a concave edge, where both faces hold it)
+   stops Newton from alternating between them. A slave that falls onto no face but lies within
+   the margin of an edge or vertex of one — beyond the faces on both sides of a convex edge, or
+   beyond an edge of the surface's border — meets that edge or vertex (:mod:`.kernels3d`, modes
+   1 and 2): crossing from face to edge to face the contact point, the normal and the gap are
+   continuous;
 3. the kernels give the pair's gap, force and tangent (15 dofs: the slave, then four face nodes;
    a triangle's fourth is none).
 
+A shell's mid-surface is a two-sided master: a slave meets the face at half the thickness on its
+own side (the side of the mid-surface it is on), and a shell's free edge as a rounded edge. A 3D
+beam meets faces by its nodes, each a sphere of the section's outer radius.
+
 The slaves' tributary areas are those of the slave surface in the reference configuration
-(∫ N_a dA over the faces at each node). Frictionless.
+(∫ N_a dA over the faces at each node; a beam node's share of length times the section's
+width). Frictionless.
 """
 from __future__ import annotations
 
@@ -64,23 +73,47 @@ class Interface3D(Interface):
     FACETS = "faces"
     master_surface = "flat master faces"
     INSIDE_TOLERANCE = 1e-9  # a projection this far (in the face's parameters) beyond an edge is on it
-    FREE_EDGE_TOLERANCE = 0.05  # beyond an edge of the surface's border: this far (× the face) still on it
+    FREE_EDGE_TOLERANCE = 0.05  # a solid's slave beyond the surface's border: this far (× the face) still on it
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = False):
         if smooth:
             raise ContactError("3D contact: the smoothed master surface is not available yet; give smooth=False "
                                "(flat faces with edge and vertex contact)")
         super().__init__(slaves, masters, law, smooth)
+        if self.slave.dim == 1:  # a beam's nodes: its share of length times the section's width
+            self.area = self.area * 2.0 * self.slave_face
         self._virtual = None
+        self.previous_face = np.full(len(self.area), -1)  # each slave's face at the last evaluation
+
+    def bind(self, system) -> None:
+        super().bind(system)
+        self.previous_face = np.full(len(self.area), -1)
+
+    def kept_state(self):
+        """What a cut step restores besides the multipliers: the faces of the last evaluation."""
+        return self.previous_face.copy()
+
+    def restore_kept(self, state) -> None:
+        self.previous_face[:] = state
 
     def _init_master(self) -> None:
         """The master faces padded to four nodes (a triangle's fourth is its first), the nodes of
-        each, and the edges (j, j + 1) of each face that border the surface (one face only): a
-        slave a little beyond them still meets the face, as in 2D beyond a free end."""
-        for surf, spec in ((self.slave, self.slave_spec), (self.master, self.master_spec)):
-            if surf.dim != 2:
-                raise ContactError(f"3D contact: '{spec[1]}' of {spec[0].kind} '{spec[0].name}' is not a surface of "
-                                   "faces (3D solids are supported so far)")
+        each, and the edges (j, j + 1) of each face that border the surface (one face only). A
+        slave with an offset (a beam's radius, a shell's half thickness) beyond such an edge meets
+        the edge (or its vertex), as beyond a convex edge inside the surface: gap and normal pass
+        continuously from the face to the rounded edge. A solid's slave a little beyond it (by the
+        free-edge tolerance) still meets the face, as in 2D beyond a free end: on a border shared
+        by both bodies (the patch test's) a slave penetrating by p/ε a hair beyond the edge would
+        otherwise take the edge's normal, tilted by the ratio of the two."""
+        part, group = self.master_spec
+        if self.master.dim != 2:
+            raise ContactError(f"3D contact: the master '{group}' of {part.kind} '{part.name}' is a line, not a "
+                               "surface of faces: a 3D beam meets solids and shells by its nodes, so give it as "
+                               "the slaves (solid–beam contact is one-pass: symmetric=False)")
+        part, group = self.slave_spec
+        if self.slave.dim == 1 and not np.all(self.slave.offsets > 0.0):
+            raise ContactError(f"3D contact: the slaves '{group}' of {part.kind} '{part.name}' are lines without a "
+                               "section radius (bars): give the beams a section with an outer size")
         faces = self.master.facets
         k = faces.shape[1]
         self.faces = np.hstack([faces, np.repeat(faces[:, :1], 4 - k, axis=1)]).astype(np.int64)
@@ -91,6 +124,9 @@ class Interface3D(Interface):
 
     @staticmethod
     def _tributary(X: np.ndarray, facets: np.ndarray) -> np.ndarray:
+        """Each slave's share of its surface: of the faces' area, or of a beam's length."""
+        if facets.shape[1] == 2:
+            return Interface._tributary(X, facets)
         return tributary_areas(X, facets)
 
     # -- pairs ------------------------------------------------------------------------------
@@ -120,28 +156,35 @@ class Interface3D(Interface):
             self.pairs_changed = True
         self.anchor = (xs.copy(), xm.copy())
 
-    def _assign(self, xs, xm, pairs):
-        """(face, mode, which), each (n_slaves,), of this rank's candidate pairs: mode 0 on the face,
-        1 on its edge ``which``, 2 at its vertex ``which``; face −1: no partner."""
+    def _assign(self, xs, xm, pairs, prefer=None):
+        """(face, mode, which, side), each (n_slaves,), of this rank's candidate pairs: mode 0 on the
+        face, 1 on its edge ``which``, 2 at its vertex ``which``; face −1: no partner; side 0 against
+        a one-sided master, ±1 the side of a two-sided one (a shell's) the slave is on. ``prefer``
+        (n_slaves,): a face each slave keeps while its projection still falls onto it."""
         n = len(self.area)
         face = np.full(n, -1)
         mode = np.zeros(n, dtype=np.int64)
         which = np.zeros(n, dtype=np.int64)
+        side = np.zeros(n)
         if not len(pairs):
-            return face, mode, which
+            return face, mode, which, side
         s, m = pairs[:, 0], pairs[:, 1]
         k = len(pairs)
         xi, eta, dist = np.zeros(k), np.zeros(k), np.zeros(k)
         on = np.zeros(k, dtype=bool)
         kernels3d.closest_on_faces(xs, xm, self.faces, self.nodes, s, m, self.INSIDE_TOLERANCE, xi, eta, dist, on)
-        g = dist - self.slave_offset[s] - self.master_offset[m]
-        on |= self._beyond_free_edges(m, xi, eta)
+        sides = np.where(dist < 0.0, -1.0, 1.0) if self.two_sided else np.zeros(k)
+        offset = self.slave_offset[s] + self.master_offset[m]
+        g = (np.abs(dist) if self.two_sided else dist) - offset
+        on |= self._beyond_free_edges(m, xi, eta) & (offset == 0.0)
         valid = on & (g > -self.h) & (g < self.margin)
         if valid.any():
             v = np.flatnonzero(valid)
-            order = np.lexsort((m[v], np.abs(g[v]), s[v]))
+            other = np.ones(len(v), dtype=np.int64) if prefer is None else (prefer[s[v]] != m[v]).astype(np.int64)
+            order = np.lexsort((m[v], np.abs(g[v]), other, s[v]))
             first = v[order][np.r_[True, np.diff(s[v[order]]) != 0]]
             face[s[first]] = m[first]
+            side[s[first]] = sides[first]
         # slaves on no face: the nearest point of the faces' edges and vertices, if within the margin
         rest = np.flatnonzero(face[s] < 0)
         if len(rest):
@@ -160,11 +203,12 @@ class Interface3D(Interface):
                     if dist_e[i] < best[slave] - 1e-14 * self.h:
                         best[slave] = dist_e[i]
                         face[slave] = m[rest[i]]
+                        side[slave] = 1.0 if self.two_sided else 0.0
                         if 0.0 < t[i] < 1.0:
                             mode[slave], which[slave] = 1, j
                         else:
                             mode[slave], which[slave] = 2, (j if t[i] == 0.0 else (j + 1) % self.nodes[m[rest[i]]])
-        return face, mode, which
+        return face, mode, which, side
 
     def _beyond_free_edges(self, m: np.ndarray, xi: np.ndarray, eta: np.ndarray) -> np.ndarray:
         """Whether each projection (ξ, η) on face m lies beyond the face's edges by at most the
@@ -186,8 +230,9 @@ class Interface3D(Interface):
         self._x = (xs, xm)
         if not self.comm.allreduce(len(self.candidates), op=MPI.SUM):  # nothing near: an idle interface
             n = len(self.area)
-            self._assigned = (np.full(n, -1), np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64))
+            self._assigned = (np.full(n, -1), np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), np.zeros(n))
             self.active[:] = -1
+            self.previous_face[:] = -1
             none = np.zeros(0, dtype=np.int64)
             if self.first_evaluation:
                 self.first_evaluation, self.had_contact = False, False
@@ -196,8 +241,9 @@ class Interface3D(Interface):
             self._forces = (none, none, np.zeros((0, PAIR_DOFS)))
             return (np.zeros((0, PAIR_DOFS), dtype=np.int64), np.zeros((0, PAIR_DOFS)),
                     np.zeros((0, PAIR_DOFS, PAIR_DOFS)), (none, none))
-        self._assigned = self._assign(xs, xm, self.candidates)
-        face, mode, which = self._assigned
+        self._assigned = self._assign(xs, xm, self.candidates, self.previous_face)
+        face, mode, which, side = self._assigned
+        self.previous_face = np.where(mode == 0, face, -1)
         s = self.mine[face[self.mine] >= 0]
         m = face[s]
         self.active[:] = -1
@@ -208,7 +254,7 @@ class Interface3D(Interface):
         K = np.zeros((n, PAIR_DOFS, PAIR_DOFS))
         lam = self.multiplier[s]
         offset = self.slave_offset[s] + self.master_offset[m]
-        kernels3d.pairs_to_faces(xs, xm, self.faces, self.nodes, s, m, mode[s], which[s], offset, lam,
+        kernels3d.pairs_to_faces(xs, xm, self.faces, self.nodes, s, m, mode[s], which[s], side[s], offset, lam,
                                  np.full(n, self.penalty), self.area[s], True, g, f, K, self.touch)
         if self.first_evaluation:
             self.first_evaluation = False
@@ -226,7 +272,7 @@ class Interface3D(Interface):
         xs, xm = self._positions(self.slave), self._positions(self.master)
         self.anchor = None
         self._search(xs, xm)
-        face, mode, which = self._assign(xs, xm, self.candidates)
+        face, mode, which, side = self._assign(xs, xm, self.candidates)
         s = self.mine[(face[self.mine] >= 0) & ~self.gap_cancelled[self.mine]]
         if slaves is not None:
             s = s[np.isin(s, slaves)]
@@ -234,7 +280,7 @@ class Interface3D(Interface):
         if len(s):
             n = len(s)
             gs = np.zeros(n)
-            kernels3d.pairs_to_faces(xs, xm, self.faces, self.nodes, s, face[s], mode[s], which[s],
+            kernels3d.pairs_to_faces(xs, xm, self.faces, self.nodes, s, face[s], mode[s], which[s], side[s],
                                      self.slave_offset[s] + self.master_offset[face[s]], np.zeros(n),
                                      np.full(n, self.penalty), self.area[s], False, gs, np.zeros((n, PAIR_DOFS)),
                                      np.zeros((n, PAIR_DOFS, PAIR_DOFS)))
@@ -257,7 +303,7 @@ class Interface3D(Interface):
         if not len(self.mine):
             return 0.0
         xs, xm = self._x
-        face, mode, which = self._assigned
+        face, mode, which, side = self._assigned
         mine = self.mine
         worst = 0.0
         gap = np.full(len(self.area), np.inf)
@@ -271,6 +317,7 @@ class Interface3D(Interface):
             dface = np.where(three, dm[self.faces[m, :3]].mean(axis=1), dm[self.faces[m]].mean(axis=1))
             n = np.cross(xm[self.faces[m, 1]] - xm[self.faces[m, 0]], xm[self.faces[m, 2]] - xm[self.faces[m, 0]])
             n /= np.linalg.norm(n, axis=1)[:, None]
+            n[side[on] < 0.0] *= -1.0  # the far side of a two-sided master
             worst = max(worst, self._ratio(ds[on] - dface, n, np.maximum(gap[on], 0.0) + self.margin, self.margin))
         free = mine[face[mine] < 0]
         if len(free):

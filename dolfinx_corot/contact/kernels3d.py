@@ -13,6 +13,10 @@ closest point to the slave
 * at the vertex v (``mode`` 2): x_c = x_v, n = ±(x_s − x_v)/|x_s − x_v|,
 
 the sign making n point out of the master (the side of the face normal at the face's centre).
+A two-sided master (a shell's mid-surface, whose contact faces lie at ±t/2 on either side) is
+met on the slave's ``side`` (±1): on the face n = side × the face normal, at an edge or a vertex
+n = (x_s − x_c)/|x_s − x_c| (the free edge of a shell is met as a rounded edge); ``side`` 0 is
+the one-sided master of a solid.
 Gap g = (x_s − x_c)·n − offset (offset: a shell's half thickness, a beam's half depth); pressure
 p = ⟨λ − ε g⟩ (penalty ε; λ the augmented-Lagrangian multiplier, 0 for pure penalty); with the
 slave's tributary area A the pair's energy is W = A ⟨λ − ε g⟩²/(2ε) and its internal force
@@ -149,10 +153,10 @@ def inside(k, xi, eta, tol):
 
 
 @numba.njit(cache=True)
-def _contact_point(x, k, mode, which, N, n):
+def _contact_point(x, k, mode, which, side, N, n):
     """The contact point's weights N (k,) on the face nodes and the unit normal n (3,) out of the
-    master, for ``mode`` 0 (face), 1 (edge ``which``) or 2 (vertex ``which``); returns the distance
-    (x_s − x_c)·n."""
+    master, for ``mode`` 0 (face), 1 (edge ``which``) or 2 (vertex ``which``), on ``side`` (0:
+    one-sided; ±1: that side of a two-sided master); returns the distance (x_s − x_c)·n."""
     dt = x.dtype
     zero = x[0, 0] * 0.0
     dN = np.empty((k, 2), dtype=dt)
@@ -180,6 +184,8 @@ def _contact_point(x, k, mode, which, N, n):
                 t2[d] += dN[a, 1] * x[1 + a, d]
         _cross(t1, t2, n)
         norm = np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
+        if side < 0.0:
+            norm = -norm
         for d in range(3):
             n[d] /= norm
     else:
@@ -198,16 +204,16 @@ def _contact_point(x, k, mode, which, N, n):
         else:
             N[which] = 1.0
         norm2 = zero
-        side = 0.0
+        along = 0.0
         for d in range(3):
             xc = zero
             for a in range(k):
                 xc += N[a] * x[1 + a, d]
             n[d] = x[0, d] - xc
             norm2 += n[d] * n[d]
-            side += (n[d] * nc[d]).real
+            along += (n[d] * nc[d]).real
         norm = np.sqrt(norm2)
-        sign = 1.0 if side >= 0.0 else -1.0
+        sign = 1.0 if (along >= 0.0 or side != 0.0) else -1.0
         for d in range(3):
             n[d] = sign * n[d] / norm
     dist = zero
@@ -220,13 +226,13 @@ def _contact_point(x, k, mode, which, N, n):
 
 
 @numba.njit(cache=True)
-def _force(x, k, mode, which, offset, lam, eps, area, f):
+def _force(x, k, mode, which, side, offset, lam, eps, area, f):
     """Gap and internal force f (3 (1 + k),) of one pair (see the module's docstring)."""
     dt = x.dtype
     zero = x[0, 0] * 0.0
     N = np.empty(k, dtype=dt)
     n = np.empty(3, dtype=dt)
-    g = _contact_point(x, k, mode, which, N, n) - offset
+    g = _contact_point(x, k, mode, which, side, N, n) - offset
     p = lam - eps * g
     if p.real <= 0.0:
         p = zero
@@ -238,18 +244,19 @@ def _force(x, k, mode, which, offset, lam, eps, area, f):
 
 
 @numba.njit(cache=True)
-def node_to_face(x, k, mode, which, offset, lam, eps, area, tangent, f, K, touch=0.0):
+def node_to_face(x, k, mode, which, side, offset, lam, eps, area, tangent, f, K, touch=0.0):
     """Gap g, force f (3 (1 + k),) and (``tangent``) K = ∂f/∂x (3 (1 + k), 3 (1 + k)) of one pair
-    x (1 + k, 3) in ``mode`` 0 (face), 1 (edge ``which``), 2 (vertex ``which``). A pair open by
+    x (1 + k, 3) in ``mode`` 0 (face), 1 (edge ``which``), 2 (vertex ``which``), on ``side`` (0:
+    a one-sided master; ±1: that side of a two-sided one). A pair open by
     less than ``touch`` (λ − ε g ≥ −ε touch, no force) keeps the penalty stiffness A ε ∇g ∇gᵀ in
     its tangent: bodies touching without load are held in the linearization."""
-    g = _force(x, k, mode, which, offset, lam, eps, area, f)
+    g = _force(x, k, mode, which, side, offset, lam, eps, area, f)
     if tangent and lam - eps * g <= 0.0:
         K[:, :] = 0.0
         if lam - eps * g >= -eps * touch:
             N = np.empty(k)
             n = np.empty(3)
-            _contact_point(x, k, mode, which, N, n)
+            _contact_point(x, k, mode, which, side, N, n)
             grad = np.zeros(3 * (1 + k))
             for d in range(3):
                 grad[d] = n[d]
@@ -266,7 +273,7 @@ def node_to_face(x, k, mode, which, offset, lam, eps, area, tangent, f, K, touch
         for j in range(m):
             node, d = divmod(j, 3)
             xc[node, d] += 1j * H
-            _force(xc, k, mode, which, offset, lam, eps, area, fc)
+            _force(xc, k, mode, which, side, offset, lam, eps, area, fc)
             xc[node, d] = x[node, d]
             for i in range(m):
                 K[i, j] = fc[i].imag / H
@@ -274,8 +281,9 @@ def node_to_face(x, k, mode, which, offset, lam, eps, area, tangent, f, K, touch
 
 
 @numba.njit(cache=True)
-def pairs_to_faces(xs, xm, faces, nodes, s, m, mode, which, offset, lam, eps, area, tangent, g, f, K, touch=0.0):
-    """node_to_face for pairs (slave s[i], face m[i]) of slaves xs (ns, 3) against faces (nf, 4)
+def pairs_to_faces(xs, xm, faces, nodes, s, m, mode, which, side, offset, lam, eps, area, tangent, g, f, K,
+                   touch=0.0):
+    """node_to_face for pairs (slave s[i], face m[i]) on side[i] of slaves xs (ns, 3) against faces (nf, 4)
     of master nodes xm (nm, 3) with ``nodes`` (nf,) nodes each (3: the fourth entry unused):
     g (p,), f (p, 15), K (p, 15, 15), zero beyond a triangle's 12 dofs; ``touch`` as in
     :func:`node_to_face`."""
@@ -287,7 +295,8 @@ def pairs_to_faces(xs, xm, faces, nodes, s, m, mode, which, offset, lam, eps, ar
             x[1 + a] = xm[faces[m[i], a]]
         fi = np.zeros(3 * (1 + k))
         Ki = np.zeros((3 * (1 + k), 3 * (1 + k)))
-        g[i] = node_to_face(x, k, mode[i], which[i], offset[i], lam[i], eps[i], area[i], tangent, fi, Ki, touch)
+        g[i] = node_to_face(x, k, mode[i], which[i], side[i], offset[i], lam[i], eps[i], area[i], tangent, fi, Ki,
+                            touch)
         f[i, :] = 0.0
         K[i, :, :] = 0.0
         f[i, : 3 * (1 + k)] = fi

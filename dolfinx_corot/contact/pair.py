@@ -91,8 +91,8 @@ class ContactPair:
                     and np.array_equal(other.slave.keys, first.master.keys)):
                 raise ValueError(f"contact '{self.name}': the second pass '{other.name}' is not the first "
                                  "one reversed")
-        self._chains = [_chains(surf.facets) if surf.two_sided else (surf.facets, np.zeros(len(surf.facets), int))
-                        for surf in (first.slave, first.master)]
+        self._chains = [_chains(surf.facets) if surf.two_sided and surf.gdim == 2
+                        else (surf.facets, np.zeros(len(surf.facets), int)) for surf in (first.slave, first.master)]
 
     @property
     def exists(self) -> bool:
@@ -157,8 +157,12 @@ class ContactPair:
         return InterfacePressure(surf.keys, face, pressure, length, force, normal)
 
     def _pressure_3d(self, surf, slaves_side: bool, current: bool) -> InterfacePressure:
-        """The 3D interface pressure on a solid's faces: the nodal contact forces of both passes over
-        the nodes' tributary areas, along the area-weighted mean outward normal at each node."""
+        """The 3D interface pressure: the nodal contact forces of both passes over the nodes'
+        tributary areas, along the area-weighted mean normal at each node — out of a solid; for a
+        shell the side the node's force comes from, the face point half the thickness from the
+        mid-surface. On a beam (nodes as slaves) the pressure is over the node's share of length
+        times the section's width, along the force, on the section's outer face."""
+        from .interface import tributary_lengths
         from .interface3d import tributary_areas
 
         first = self.interfaces[0]
@@ -168,14 +172,22 @@ class ContactPair:
         force = -total
         x = surf.positions(first.comm) if current else surf.X
         faces = surf.facets
-        normal = np.zeros_like(x)
-        for j in range(faces.shape[1]):  # each corner's normal (x_{j+1} − x_j) × (x_{j−1} − x_j)
-            a, b, c = faces[:, j], faces[:, (j + 1) % faces.shape[1]], faces[:, j - 1]
-            np.add.at(normal, a, np.cross(x[b] - x[a], x[c] - x[a]))
-        normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
-        area = tributary_areas(x, faces)
+        offsets = surf.node_offsets()
+        if surf.dim == 1:
+            magnitude = np.linalg.norm(force, axis=1)
+            normal = -force / np.where(magnitude > 0.0, magnitude, 1.0)[:, None]
+            area = tributary_lengths(x, faces) * 2.0 * offsets
+        else:
+            normal = np.zeros_like(x)
+            for j in range(faces.shape[1]):  # each corner's normal (x_{j+1} − x_j) × (x_{j−1} − x_j)
+                a, b, c = faces[:, j], faces[:, (j + 1) % faces.shape[1]], faces[:, j - 1]
+                np.add.at(normal, a, np.cross(x[b] - x[a], x[c] - x[a]))
+            normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+            if surf.two_sided:  # towards the other body: against the force on the node
+                normal *= np.where(np.einsum("ij,ij->i", force, normal) > 0.0, -1.0, 1.0)[:, None]
+            area = tributary_areas(x, faces)
         pressure = -np.einsum("ij,ij->i", force, normal) / area
-        return InterfacePressure(surf.keys, x, pressure, area, force, normal)
+        return InterfacePressure(surf.keys, x + offsets[:, None] * normal, pressure, area, force, normal)
 
     def resultant(self, on: str = "slaves") -> np.ndarray:
         """(gdim,) the total force that the other body exerts on the ``on`` side (both passes)."""

@@ -16,6 +16,7 @@ located by their coordinates.
 """
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -45,8 +46,9 @@ class TaggedMesh:
     uses). Input numbers tell apart nodes that share a position (the two
     sides of a slit, two bodies that touch).
     node_source: meshes with the same source number their nodes alike (the
-    gmsh node tags of one gmsh model): parts on such meshes share the nodes
-    they have in common (a beam stiffening a shell).
+    gmsh node tags of one meshed gmsh model, identified by its name and its
+    nodes): parts on such meshes share the nodes they have in common (a beam
+    stiffening a shell); meshes of different gmsh models or sessions never do.
     """
 
     mesh: dolfinx.mesh.Mesh
@@ -299,7 +301,12 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
                 node_ids[name] = np.unique(nodes[used] - 1)  # input node number = gmsh tag − 1
                 if not np.all(used):  # e.g. a gmsh point not embedded in the surface: by position
                     points[name] = np.asarray(coords, dtype=float).reshape(-1, 3)[~used]
-        source = f"gmsh:{model.getCurrent()}"
+        # the model's name and a digest of all its nodes (tags and coordinates): reading one meshed
+        # model twice (cells of two dimensions) gives one source; two meshes made in separate gmsh
+        # sessions, whose tags both start at 1, never do, whatever their models are called
+        tags, coords, _ = model.mesh.getNodes()
+        digest = hashlib.sha1(np.asarray(tags, dtype=np.int64).tobytes() + np.asarray(coords, dtype=float).tobytes())
+        source = f"gmsh:{model.getCurrent()}:{digest.hexdigest()[:16]}"
     else:
         source = None
         tdim = None

@@ -470,7 +470,7 @@ class Part:
         """The contact surface of group ``where`` (parts that have none refuse); ``body``: the
         region whose face it is, where the group's lines separate two regions of one mesh."""
         raise SurfaceError(f"contact surface '{where}': {self.kind_name} parts in {self.gdim}D are not supported "
-                           "as contact surfaces so far (2D and 3D solids and 2D beams are)")
+                           "as contact surfaces so far (solids, 2D beams, 3D beams as slaves, shells and membranes are)")
 
     # -- state ----------------------------------------------------------------------
     def checkpoint(self) -> np.ndarray:

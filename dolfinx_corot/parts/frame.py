@@ -477,12 +477,15 @@ class Frame3D(Rotations3D, LineFrame):
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
         LineFrame.__init__(self, tmesh, large_rotations)
         self._init_state()
+        # the distance from the axis at which each cell's section meets a contact surface
+        self._contact_radius = np.zeros(len(self._owner_of_cell))
 
     def add_beam(self, where, section, material, kinematics, orientation, plane_strain=False) -> PartRef:
         if plane_strain:
             raise ValueError(f"beam '{where}': plane_strain is for 2D beams (a plate strip of unit width); "
                              "a beam in 3D has its own section")
         GAs = material.G * section.As if kinematics == "timoshenko" else 0.0
+        self._contact_radius[self.tmesh.cells(where)] = section.contact_radius
         return self._add(where, {"EA": material.E * section.A, "GJ": material.G * section.torsion_constant,
                                  "EIy": material.E * section.second_moment_y, "EIz": material.E * section.I,
                                  "GAy": GAs, "GAz": GAs}, orientation, 0.0, "beam")
@@ -505,6 +508,19 @@ class Frame3D(Rotations3D, LineFrame):
                           N0, *v])
         bending = values["EIy"] > 0.0 or values["EIz"] > 0.0
         return self.add_elements(where, props, bending, kind)
+
+    def surface(self, where: str, body: str | None = None) -> Surface:
+        """The nodes of the beams of line group ``where`` as contact slaves: each meets a surface at
+        its section's contact radius (``Section.outer``: a pipe's or a circle's outer radius, a
+        rectangle's half depth) from the axis, on any side; the segments give each node its share of
+        the beam's length."""
+        cells = self.tmesh.cells(where)
+        cells = cells[cells < self.tmesh.mesh.topology.index_map(1).size_local]
+        seg_blocks = np.array([self.V.dofmap.cell_dofs(c) for c in cells], dtype=np.int64).reshape(-1, 2)
+        if self.comm.allreduce(int(np.any(self._owner_of_cell[cells] == "")), op=MPI.MAX):
+            raise SurfaceError(f"contact surface '{where}': some of its lines carry no beam")
+        return gather_surface(self, where, seg_blocks, self.V.tabulate_dof_coordinates(),
+                              offsets=self._contact_radius[cells], two_sided=True, modulus=None, cells=cells)
 
     def _check_geometry(self, cells, label, props):
         super()._check_geometry(cells, label, props)

@@ -10,6 +10,7 @@ so that they share nodes with beams.
 from __future__ import annotations
 
 import numpy as np
+from mpi4py import MPI
 
 import dolfinx.fem
 
@@ -21,6 +22,7 @@ from ..kernels import shell3d as kernels_shell
 from .base import PartRef
 from .cells import mesh_extent, quadrilateral_problems, refuse, triangle_problems
 from .frame import Frame3D, LineFrame, Rotations3D
+from .surface import Surface, SurfaceError, gather_surface
 
 
 class Surface3D(Rotations3D, LineFrame):
@@ -52,6 +54,25 @@ class Surface3D(Rotations3D, LineFrame):
         self.kernels.element_data_all(X, props, self._owner_of_cell != "", out)
         edata.x.array.reshape(-1, n)[Q.dofmap.list.array] = out
         return [edata]
+
+    def surface(self, where: str, body: str | None = None) -> Surface:
+        """The shells or membranes of cell group ``where`` as a two-sided contact surface: their
+        mid-surface faces (triangles, or quadrilaterals with corners in cyclic order), met at half
+        the thickness on either side along the current face normal — which turns with the
+        element, so the contact faces follow the shell's rotations; a slave shell node meets
+        other surfaces at its half thickness. Stiffness scale: the smallest E/(1 − ν²)."""
+        n_owned = self.tmesh.mesh.topology.index_map(2).size_local
+        cells = self.tmesh.cells(where)
+        cells = cells[cells < n_owned]
+        if self.comm.allreduce(int(np.any(self._owner_of_cell[cells] == "")), op=MPI.MAX):
+            raise SurfaceError(f"contact surface '{where}': some of its cells carry no shell or membrane")
+        order = kernels_mq.CCW if self.nodes_per_cell == 4 else np.arange(3)
+        blocks = np.array([self.V.dofmap.cell_dofs(c) for c in cells], dtype=np.int64).reshape(-1, self.nodes_per_cell)
+        props = self.cell_properties(cells)
+        E, nu, t = props[:, 0], props[:, 1], props[:, 2]
+        modulus = self.comm.allreduce(float(np.min(E / (1.0 - nu**2), initial=np.inf)), op=MPI.MIN)
+        return gather_surface(self, where, blocks[:, order], self.V.tabulate_dof_coordinates(), offsets=0.5 * t,
+                              two_sided=True, modulus=modulus, cells=cells)
 
 
 class Shell3D(Surface3D):

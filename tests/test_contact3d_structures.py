@@ -21,21 +21,24 @@ SIDE = 1.0                           # the plate covers the block's top
 R_PIPE, T_PIPE = 0.05, 0.01          # the pipe: outer radius, wall
 
 
-def _block(h: float):
-    """The block of tetrahedra of size h: faces 'base', 'top', 'x0', 'y0'."""
+def _block(h: float, length: float = 1.0, sides=("x0", "y0")):
+    """The block [0, length] × [0, 1] × [0, H] of tetrahedra of size h: faces 'base', 'top' and
+    ``sides``: the faces x = 0 and y = 0 ('x0', 'y0'), or both x faces and both y faces
+    ('xends', 'ysides')."""
     if comm.rank == 0:
         gmsh.initialize()
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("block")
         occ = gmsh.model.occ
-        v = occ.addBox(0, 0, 0, 1, 1, H)
+        v = occ.addBox(0, 0, 0, length, 1, H)
         occ.synchronize()
         gmsh.model.mesh.setSize(gmsh.model.getBoundary([(3, v)], recursive=True), h)
         groups = {}
         for _, tag in gmsh.model.getBoundary([(3, v)], oriented=False):
             x, y, z = occ.getCenterOfMass(2, tag)
-            name = ("base" if z < 1e-9 else "top" if z > H - 1e-9 else "x0" if x < 1e-9 else
-                    "y0" if y < 1e-9 else None)
+            name = ("base" if z < 1e-9 else "top" if z > H - 1e-9 else
+                    sides[0] if x < 1e-9 or (sides[0] == "xends" and x > length - 1e-9) else
+                    sides[1] if y < 1e-9 or sides[1] == "ysides" else None)
             if name:
                 groups.setdefault(name, []).append(tag)
         gmsh.model.setPhysicalName(3, gmsh.model.addPhysicalGroup(3, [v]), "block")
@@ -278,8 +281,9 @@ def test_meshes_of_separate_gmsh_sessions_do_not_share_nodes():
 
 
 def test_structure_contact_input_is_checked_by_name():
-    """A pipe's lines given as the master, bars without a section radius as slaves, and a shell
-    group that is not a group of its cells are refused, each by name."""
+    """A pipe's lines given as the master, bars without a section radius as slaves, a pipe wall
+    thicker than its radius, a negative contact radius, and a shell group that is not a group of
+    its cells are refused, each by name."""
     sc, b, pipe, pair, _ = _pipe_scene()
     with pytest.raises(dc.ContactError, match="the master 'beam' of beam 'beam' is a line"):
         sc.contact((b, "top"), (pipe, "beam"))
@@ -288,6 +292,10 @@ def test_structure_contact_input_is_checked_by_name():
                          material=dc.Elastic(1000.0, 0.3))
     with pytest.raises(dc.ContactError, match="the slaves 'bars' of truss 'bars' are lines without a section radius"):
         sc2.contact((bars, "bars"), (b2, "top"))
+    with pytest.raises(ValueError, match="Pipe: diameter d = 0.1 and wall thickness t = 0.06"):
+        dc.Pipe(0.1, 0.06)
+    with pytest.raises(ValueError, match="outer = -1.0 must be finite and not negative"):
+        dc.Section(A=1.0, I=1.0, outer=-1.0)
     sc3, b3, plate, _ = _plate_scene("shell slaves")
     with pytest.raises(ValueError, match="px0"):
         sc3.contact((b3, "top"), (plate, "px0"))
@@ -303,28 +311,7 @@ def test_a_pipe_dragged_over_the_edge_of_a_coarse_block_converges():
     converges without a cut (at most 8 Newton iterations), the contact carries the weight at
     every step (1e-9), and the pull stays below 0.1 of it (frictionless: only the pipe's end
     tipping over the edge pulls it on)."""
-    import gmsh as _gmsh
-
-    if comm.rank == 0:
-        _gmsh.initialize()
-        _gmsh.option.setNumber("General.Terminal", 0)
-        _gmsh.model.add("soil")
-        occ = _gmsh.model.occ
-        v = occ.addBox(0, 0, 0, 2.0, 1.0, H)
-        occ.synchronize()
-        _gmsh.model.mesh.setSize(_gmsh.model.getBoundary([(3, v)], recursive=True), 0.2)
-        groups = {}
-        for _, tag in _gmsh.model.getBoundary([(3, v)], oriented=False):
-            x, y, z = occ.getCenterOfMass(2, tag)
-            name = "base" if z < 1e-9 else "top" if z > H - 1e-9 else "xends" if (x < 1e-9 or x > 2 - 1e-9) else "ysides"
-            groups.setdefault(name, []).append(tag)
-        _gmsh.model.setPhysicalName(3, _gmsh.model.addPhysicalGroup(3, [v]), "soil")
-        for name, tags in groups.items():
-            _gmsh.model.setPhysicalName(2, _gmsh.model.addPhysicalGroup(2, tags), name)
-        _gmsh.model.mesh.generate(3)
-    tm = from_gmsh(_gmsh.model if comm.rank == 0 else None, 3, comm=comm)
-    if comm.rank == 0:
-        _gmsh.finalize()
+    tm = _block(0.2, length=2.0, sides=("xends", "ysides"))
     sc = dc.Scene(large_rotations=True, linear_solver="direct")
     soil = sc.add_solid(tm, material=dc.Elastic(E, NU), degree=1)
     sc.fix(soil, "base")

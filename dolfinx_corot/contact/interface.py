@@ -299,6 +299,14 @@ class Interface:
                 return x, float(xi[0])
         return None, None
 
+    def _broad_phase(self, xs: np.ndarray, xm: np.ndarray) -> np.ndarray:
+        """Candidate pairs (k, 2) [index into xs, segment]: the segments' boxes inflated by the
+        margin and the offsets (beams: the surfaces lie up to half their depth from the axes the
+        search sees)."""
+        seg = self.master.facets
+        reach = self.margin + self.slave_offset.max(initial=0.0) + self.master_offset.max(initial=0.0)
+        return broad_phase(xs, xm[seg[:, 0]], xm[seg[:, 1]], reach)
+
     def pair_dofs(self, slaves: np.ndarray, segments: np.ndarray) -> np.ndarray:
         """Global dofs (k, 10) of slave–segment pairs (slave, p, a, b, q), −1 on constrained dofs
         (PETSc skips them in matrices)."""
@@ -323,10 +331,7 @@ class Interface:
             np.abs(xs - self.anchor[0]).max(initial=0.0), np.abs(xm - self.anchor[1]).max(initial=0.0))
         if moved <= 0.5 * self.margin:
             return
-        seg = self.master.facets
-        # beams: the surfaces lie up to half their depth from the axes the search sees
-        reach = self.margin + self.slave_offset.max(initial=0.0) + self.master_offset.max(initial=0.0)
-        pairs = broad_phase(xs[self.mine], xm[seg[:, 0]], xm[seg[:, 1]], reach)
+        pairs = self._broad_phase(xs[self.mine], xm)
         pairs[:, 0] = self.mine[pairs[:, 0]]
         pairs = self._existing_pairs(pairs)
         union = np.unique(np.vstack([self.candidates, pairs]), axis=0)

@@ -139,22 +139,12 @@ class Interface3D(Interface):
         dofs[np.isin(dofs, self.constrained)] = -1
         return dofs
 
-    def _search(self, xs, xm) -> None:
-        moved = np.inf if self.anchor is None else max(
-            np.abs(xs - self.anchor[0]).max(initial=0.0), np.abs(xm - self.anchor[1]).max(initial=0.0))
-        if moved <= 0.5 * self.margin:
-            return
+    def _broad_phase(self, xs: np.ndarray, xm: np.ndarray) -> np.ndarray:
+        """Candidate pairs (k, 2) [index into xs, face]: the faces' boxes inflated by the margin,
+        the slaves' largest offset and each face's own."""
         reach = self.margin + self.slave_offset.max(initial=0.0) + self.master_offset
         lo, hi = face_boxes(xm, self.master.facets, reach)
-        pairs = broad_phase_boxes(xs[self.mine], lo, hi)
-        pairs[:, 0] = self.mine[pairs[:, 0]]
-        pairs = self._existing_pairs(pairs)
-        union = np.unique(np.vstack([self.candidates, pairs]), axis=0)
-        grown = self.comm.allreduce(int(len(union) > len(self.candidates)), op=MPI.MAX)
-        if grown:
-            self.candidates = union
-            self.pairs_changed = True
-        self.anchor = (xs.copy(), xm.copy())
+        return broad_phase_boxes(xs, lo, hi)
 
     def _assign(self, xs, xm, pairs, prefer=None):
         """(face, mode, which, side), each (n_slaves,), of this rank's candidate pairs: mode 0 on the

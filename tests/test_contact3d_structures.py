@@ -310,7 +310,8 @@ def test_a_pipe_dragged_over_the_edge_of_a_coarse_block_converges():
     projects onto it: no alternation), and roll round the block's rounded border edge. Every step
     converges without a cut (at most 8 Newton iterations), the contact carries the weight at
     every step (1e-9), and the pull stays below 0.1 of it (frictionless: only the pipe's end
-    tipping over the edge pulls it on)."""
+    tipping over the edge pulls it on) and balances the contact's horizontal force (1e-10 of the
+    weight: the support's reaction holds the contact force on the supported node itself)."""
     tm = _block(0.2, length=2.0, sides=("xends", "ysides"))
     sc = dc.Scene(large_rotations=True, linear_solver="direct")
     soil = sc.add_solid(tm, material=dc.Elastic(E, NU), degree=1)
@@ -332,3 +333,4 @@ def test_a_pipe_dragged_over_the_edge_of_a_coarse_block_converges():
     assert history.column("iterations").max() <= 8
     assert np.allclose(history.column("c_Fz"), weight, rtol=1e-9)
     assert np.abs(history.column("pull_Fx")).max() < 0.1 * 1.5
+    assert np.allclose(history.column("pull_Fx"), -history.column("c_Fx"), rtol=0, atol=1e-10 * 1.5)

@@ -140,7 +140,8 @@ def test_restart_under_mpi_matches_serial(tmp_path):
 @pytest.mark.mpi
 def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
     """Parts on several meshes (shared nodes across ranks), quadrilateral membranes, continua
-    (AMG, reactions, exact homogeneous states), contact (patch test, sliding, penalty range),
+    (AMG, reactions, exact homogeneous states), contact in 2D and 3D (patch tests, sliding, penalty range,
+    shells and beams on solids),
     checkpoint and restart (exact with contact multipliers; refusals), field output, monitors on groups
     (reductions, profiles, bodies that touch), self-weight and the cell checks (the same refusal naming
     the same cell on every rank) on 2 ranks."""
@@ -150,7 +151,8 @@ def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
     per_rank = f'PYTEST_DEBUG_TEMPROOT="{tmp_path}/rank$OMPI_COMM_WORLD_RANK" exec "$@"'
     out = _run(["mpirun", "-n", "2", "sh", "-c", per_rank, "sh", sys.executable, "-m", "pytest", "-q", "-p",
                 "no:cacheprovider", "--color=no", "tests/test_coupled.py", "tests/test_membrane_quad.py",
-                "tests/test_continuum.py", "tests/test_contact.py", "tests/test_contact_pressure.py", "tests/test_restart.py",
+                "tests/test_continuum.py", "tests/test_contact.py", "tests/test_contact3d.py",
+                "tests/test_contact3d_structures.py", "tests/test_contact_pressure.py", "tests/test_restart.py",
                 "tests/test_fields.py", "tests/test_reference.py", "tests/test_bad_input.py", "tests/test_monitors.py",
                 "tests/test_self_weight.py", "tests/test_cell_checks.py", "tests/test_stabilisation.py",
                 "tests/test_stability.py", "tests/test_convergence_scale.py", "tests/test_staging.py"],

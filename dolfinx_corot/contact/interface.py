@@ -230,6 +230,11 @@ class Interface:
                                np.zeros((len(s), 10)))
             g[s] = gs
             done[s] = 1.0
+        return self._take_initial_gaps(g, done)
+
+    def _take_initial_gaps(self, g: np.ndarray, done: np.ndarray) -> int:
+        """The gaps ``g`` of the slaves this rank has ``done`` (1.0) become their initial gaps, over
+        all ranks; returns how many slaves took theirs."""
         g = self.comm.allreduce(g, op=MPI.SUM)
         done = self.comm.allreduce(done, op=MPI.SUM) > 0.0
         self.initial_gap[done] = g[done]

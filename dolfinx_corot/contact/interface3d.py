@@ -292,12 +292,7 @@ class Interface3D(Interface):
                                      np.full(n, self.penalty), self.area[s], False, gs, np.zeros((n, PAIR_DOFS)),
                                      np.zeros((n, PAIR_DOFS, PAIR_DOFS)))
             g[s], done[s] = gs, 1.0
-        g = self.comm.allreduce(g, op=MPI.SUM)
-        done = self.comm.allreduce(done, op=MPI.SUM) > 0.0
-        self.initial_gap[done] = g[done]
-        self.gap_cancelled |= done
-        self.anchor = None
-        return int(done.sum())
+        return self._take_initial_gaps(g, done)
 
     def project_slaves(self, slaves: np.ndarray) -> np.ndarray:
         raise NotImplementedError("the mapping of new continuum (staged construction, approach II) is 2D so far")

@@ -25,7 +25,8 @@ import numpy as np
 from .conditions import Condition
 from .contact.interface import Contact, Interface
 from .contact.interface3d import Interface3D
-from .contact.laws import Penalty
+from .contact.laws import ContactError, Penalty
+from .contact.mortar import MortarInterface3D
 from .contact.pair import ContactPair
 from .io.mesh import TaggedMesh
 from .materials import Elastic
@@ -306,7 +307,7 @@ class Scene:
         return condition
 
     def contact(self, slaves: tuple[PartRef, str], masters: tuple[PartRef, str], law=None,
-                symmetric: bool = False, smooth: bool | None = None) -> list:
+                symmetric: bool = False, smooth: bool | None = None, discretization: str = "node_to_face") -> list:
         """Frictionless node-to-segment (2D) or node-to-face (3D) contact of the nodes of group
         ``slaves[1]`` of part ``slaves[0]`` against the segments or faces of ``masters``;
         ``symmetric`` adds the other direction (two-pass contact, for two deformable bodies).
@@ -322,13 +323,23 @@ class Scene:
         masters); False: the straight segments (slave forces shared linearly by the segment's two
         nodes: the patch test is passed exactly). 3D: flat faces with edge and vertex contact.
 
+        discretization (3D): 'node_to_face' (default; slave nodes against master faces, every
+        kind of surface) or 'mortar' (segment-to-segment between two solids' faces: the contact
+        pressure integrated over the overlaps of slave and master faces, the nodal constraints
+        weighted gaps; passes the patch test on non-matching faces, :mod:`~dolfinx_corot.contact.mortar`).
+
         Returns a :class:`~dolfinx_corot.contact.ContactPair`, the sequence of the interfaces made
         (one, or two when symmetric), which gives the interface pressure of both passes combined
         on either side's contact face (``pair.pressure(on="slaves")``, a beam's face at half its
         depth) and its resultant; see also :meth:`monitor_contact`."""
         law = Penalty() if law is None else law
+        if discretization not in ("node_to_face", "mortar"):
+            raise ValueError(f"contact: discretization = {discretization!r} must be 'node_to_face' or 'mortar'")
         if slaves[0].model.gdim == 3:
-            kind, smooth = Interface3D, bool(smooth)
+            kind, smooth = (MortarInterface3D if discretization == "mortar" else Interface3D), bool(smooth)
+        elif discretization == "mortar":
+            raise ContactError("contact: the mortar discretization is 3D only (in 2D, node-to-segment contact on "
+                               "straight segments passes the patch test: smooth=False)")
         else:
             kind, smooth = Interface, smooth is None or bool(smooth)
         made = [kind(slaves, masters, law, smooth)]

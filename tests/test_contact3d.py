@@ -50,14 +50,17 @@ def _two_blocks(h_low: float, h_up: float, gap: float = 0.0, matching: bool = Fa
     return tm
 
 
-def _patch_scene(law, symmetric: bool = True, matching: bool = False):
+def _patch_scene(law, symmetric: bool = True, matching: bool = False, discretization: str = "node_to_face",
+                 sizes: tuple[float, float] = (0.26, 0.35)):
     sc = dc.Scene(large_rotations=False, linear_solver="direct")
-    b = sc.add_solid(_two_blocks(0.26, 0.26 if matching else 0.35, matching=matching), material=dc.Elastic(E, NU), degree=1)
+    tm = _two_blocks(sizes[0], sizes[0] if matching else sizes[1], matching=matching)
+    b = sc.add_solid(tm, material=dc.Elastic(E, NU), degree=1)
     sc.fix(b, "base", dofs=("uz",))
     sc.fix(b, "x0", dofs=("ux",))
     sc.fix(b, "y0", dofs=("uy",))
     sc.load(b, "top", traction=(0.0, 0.0, -P))
-    pair = sc.contact((b, "upper_face"), (b, "lower_face"), law=law, symmetric=symmetric)
+    pair = sc.contact((b, "upper_face"), (b, "lower_face"), law=law, symmetric=symmetric,
+                      discretization=discretization)
     sc.monitor_contact("c", pair)
     return sc, b, pair
 

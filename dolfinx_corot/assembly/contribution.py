@@ -41,6 +41,7 @@ class Contribution:
         ``system.constrained_global_dofs``)."""
 
     couplings_changed = False
+    symmetric_tangent = True  # whether its tangent blocks are symmetric (else the system solves by LU)
 
     def couplings(self) -> np.ndarray:
         """(k, n) global dofs, each row a dense block coupled by this contribution (−1: none)."""

@@ -166,17 +166,32 @@ class LinearSolver:
             and pc.getFactorSolverType() == "mumps"
         self.ldlt = self.mumps and pc.getType() == "cholesky"
         if self.mumps:
-            # null-pivot detection (ICNTL 24): a singular tangent is reported, not solved; LU also
-            # computes the determinant (ICNTL 33), whose sign is the parity of the number of
-            # negative real eigenvalues
-            pc.setFactorSetUpSolverType()
-            pc.getFactorMatrix().setMumpsIcntl(24, 1)
-            if not self.ldlt:
-                pc.getFactorMatrix().setMumpsIcntl(33, 1)
+            self._mumps_controls()
         # per factorization since the last :meth:`take_inertia`: negative eigenvalues (LDLᵀ) or
         # the sign of the determinant (LU: +1 even, −1 odd)
         self._inertia: list[int] = []
         self._signs: list[int] = []
+
+    def _mumps_controls(self) -> None:
+        """Null-pivot detection (ICNTL 24): a singular tangent is reported, not solved; LU also
+        computes the determinant (ICNTL 33), whose sign is the parity of the number of negative
+        real eigenvalues."""
+        pc = self.ksp.getPC()
+        pc.setFactorSetUpSolverType()
+        pc.getFactorMatrix().setMumpsIcntl(24, 1)
+        if not self.ldlt:
+            pc.getFactorMatrix().setMumpsIcntl(33, 1)
+
+    def set_symmetric(self, symmetric: bool) -> None:
+        """A direct solver factorizes the next tangents by LDLᵀ (``symmetric``) or LU; no change
+        for iterative solvers or when it already does."""
+        if not self.mumps or bool(symmetric) == self.ldlt:
+            return
+        pc = self.ksp.getPC()
+        pc.setType("cholesky" if symmetric else "lu")
+        pc.setFactorSolverType("mumps")
+        self.ldlt = bool(symmetric)
+        self._mumps_controls()
 
     def operator_changed(self) -> None:
         """The tangent A was re-assembled: the AIJ copy that AMG smooths with follows it."""

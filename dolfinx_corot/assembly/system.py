@@ -117,6 +117,10 @@ class System:
         self.engaged = False
         if symmetric is None:
             symmetric = model.symmetric_tangent
+        self._symmetric = symmetric
+        # a contribution whose tangent is not symmetric (mortar contact) makes the direct solver
+        # factorize by LU while it is engaged, by LDLᵀ otherwise: an idle one changes nothing
+        self._unsymmetric = any(not c.symmetric_tangent for c in self.contributions)
         self.iterative = solver == "iterative"
         nullspace = None
         if self.iterative:
@@ -411,10 +415,14 @@ class System:
         out = self.dx if out is None else out
         t = time.perf_counter()
         try:
+            self._choose_factorization()
             self.linear.solve(rhs, out)
         finally:
             self.timings.solve += time.perf_counter() - t
         return out.norm()
+
+    def _choose_factorization(self) -> None:
+        self.linear.set_symmetric(self._symmetric and not (self._unsymmetric and self.engaged))
 
     def set_forcing(self, eta: float | None) -> None:
         self.linear.set_forcing(eta)
@@ -451,6 +459,7 @@ class System:
         self._tangent_version = self._version
         if factorize:
             t = time.perf_counter()
+            self._choose_factorization()
             self.linear.factorize()
             self.timings.solve += time.perf_counter() - t
 

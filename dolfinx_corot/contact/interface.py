@@ -87,6 +87,7 @@ class Interface:
     XI_TOLERANCE = 0.05  # beyond a free end of the master surface: this far (× length) still on it
     SMOOTH_ANGLE = np.radians(60.0)  # master vertices where the surface turns more than this stay sharp
     BAND_USES = 3  # corrections per Newton solve that may count lifted pairs as closed
+    SYMMETRIC_TANGENT = True
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = True):
         if not isinstance(law, Penalty):
@@ -336,15 +337,19 @@ class Interface:
             np.abs(xs - self.anchor[0]).max(initial=0.0), np.abs(xm - self.anchor[1]).max(initial=0.0))
         if moved <= 0.5 * self.margin:
             return
-        pairs = self._broad_phase(xs[self.mine], xm)
-        pairs[:, 0] = self.mine[pairs[:, 0]]
-        pairs = self._existing_pairs(pairs)
+        pairs = self._candidate_pairs(xs, xm)
         union = np.unique(np.vstack([self.candidates, pairs]), axis=0)
         grown = self.comm.allreduce(int(len(union) > len(self.candidates)), op=MPI.MAX)
         if grown:
             self.candidates = union
             self.pairs_changed = True
         self.anchor = (xs.copy(), xm.copy())
+
+    def _candidate_pairs(self, xs, xm) -> np.ndarray:
+        """(k, 2) [slave, master facet] of this rank's slaves near existing master facets."""
+        pairs = self._broad_phase(xs[self.mine], xm)
+        pairs[:, 0] = self.mine[pairs[:, 0]]
+        return self._existing_pairs(pairs)
 
     def evaluate(self):
         """Forces and tangents of this rank's slaves at the current configuration.
@@ -666,6 +671,12 @@ class Contact(Contribution):
             itf.bind(system)
         self.comm = system.comm
 
+    @property
+    def symmetric_tangent(self) -> bool:
+        """Node-to-segment and node-to-face tangents are the Hessians of the pairs' energies;
+        mortar tangents are not symmetric."""
+        return all(itf.SYMMETRIC_TANGENT for itf in self.interfaces)
+
     # -- couplings and assembly ---------------------------------------------------------
     @property
     def couplings_changed(self) -> bool:
@@ -677,9 +688,13 @@ class Contact(Contribution):
             itf.pairs_changed = bool(value)
 
     def couplings(self) -> np.ndarray:
-        """The 10 dofs (slave, p, a, b, q) of every candidate pair of this rank."""
+        """The dofs of every candidate pair of this rank (2D: slave, p, a, b, q; 3D: the slave and a
+        face's nodes, or a slave face's and a master face's), padded with −1 to one width."""
         blocks = [itf.pair_dofs(itf.candidates[:, 0], itf.candidates[:, 1]) for itf in self.interfaces]
-        return np.concatenate(blocks) if blocks else np.zeros((0, 10), dtype=np.int64)
+        if not blocks:
+            return np.zeros((0, 10), dtype=np.int64)
+        width = max(b.shape[1] for b in blocks)
+        return np.concatenate([np.pad(b, ((0, 0), (0, width - b.shape[1])), constant_values=-1) for b in blocks])
 
     def engaged(self) -> bool:
         return any(len(itf.candidates) for itf in self.interfaces)

@@ -132,13 +132,14 @@ def test_mortar_contact_passes_the_3d_patch_test_on_non_matching_faces(symmetric
     interface meshed independently (tetrahedra of 0.26 and 0.35, faces of different sizes and
     orientations). One- and two-pass mortar contact with the augmented Lagrangian reproduce the
     homogeneous state to 1e-10 p/E (measured 1.3e-12 and 3.9e-13 after one Uzawa update), the
-    resultant is P to 1e-12 and the interface pressure P at every node to 1e-9 — node-to-face
+    resultant is P to 1e-10 (Newton's tolerance: 1e-9 of the force scale) and the interface
+    pressure P at every node to 1e-9 — node-to-face
     contact stops at 8.3e-5 p/E on these meshes (test_contact3d)."""
     sc, b, pair = _patch_scene(dc.AugmentedLagrangian(gap_tolerance=1e-9), symmetric=symmetric,
                                discretization="mortar")
     row = dc.solve(sc, dc.LoadControl(steps=1)).history.rows[-1]
     assert row["cuts"] == 0 and 1 <= row["uzawa_updates"] <= 3
-    assert row["c_Fz"] == pytest.approx(P, rel=1e-12)
+    assert row["c_Fz"] == pytest.approx(P, rel=1e-10)
     low, upper, shift = _errors(b)
     assert low < 1e-10 and upper < 1e-10 and np.abs(shift).max() < 1e-10 * P / E
     for side in ("slaves", "masters"):
@@ -149,12 +150,12 @@ def test_mortar_contact_passes_the_3d_patch_test_on_non_matching_faces(symmetric
 def test_mortar_penalty_is_exact_up_to_a_uniform_penetration():
     """With the penalty alone the mortar interface transmits a uniform pressure: the upper block is
     the homogeneous state shifted down by the penetration p/ε (the overlap measured on the current,
-    laterally stretched, faces: p/(ε (1 + ν p/E)²)), to 1e-10 p/E."""
+    laterally stretched, faces: p/(ε (1 + ν p/E)²)), to 1e-9 p/E (Newton's tolerance)."""
     sc, b, pair = _patch_scene(dc.Penalty(), symmetric=False, discretization="mortar")
     dc.solve(sc, dc.LoadControl(steps=1))
     low, upper, shift = _errors(b)
     eps = sc.interfaces[0].penalty
-    assert upper < 1e-10
+    assert upper < 1e-9
     assert shift[2] == pytest.approx(-P / (eps * (1.0 + NU * P / E) ** 2), rel=1e-8)
 
 
@@ -172,7 +173,7 @@ def test_assembled_mortar_tangent_matches_finite_differences(symmetric):
     system = make_system(sc.model, contributions=sc.contributions(), solver=sc.linear_solver)
     assert not system.contributions[0].symmetric_tangent
     for itf in sc.interfaces:  # no touch band (a stiffness without a force, by design not the derivative)
-        itf.TOUCH_EVALUATIONS, itf.closed_before = 0, True
+        itf.closed_before = True
     model = sc.model
     X = model.V.tabulate_dof_coordinates()
     u = model.state.x.array.reshape(-1, 3)

@@ -230,3 +230,31 @@ def test_mortar_input_is_checked_by_name():
                         section=dc.Rectangle(0.1, 0.1), material=dc.Elastic(E, NU))
     with pytest.raises(dc.ContactError, match="the mortar discretization is 3D only"):
         sc2.contact((beam, "beam"), (beam, "beam"), discretization="mortar")
+
+
+class _Killed(Exception):
+    pass
+
+
+def test_a_mortar_run_restarted_from_its_checkpoint_continues_exactly(tmp_path):
+    """State contract: a two-pass mortar run killed after step 2 of 3 and restarted from its file
+    (multipliers at the slave nodes, candidate face pairs of every rank) ends where the
+    uninterrupted run does: same iterations and updates, displacements to 1e-10."""
+    def on_step(row):
+        if row["step"] == 2:
+            raise _Killed
+
+    law = dc.AugmentedLagrangian(gap_tolerance=1e-9)
+    path = comm.bcast(str(tmp_path / "mortar.npz") if comm.rank == 0 else None, root=0)
+    full_scene, b_full, _ = _patch_scene(law, discretization="mortar")
+    full = dc.solve(full_scene, dc.LoadControl(steps=3))
+    killed_scene, _, _ = _patch_scene(law, discretization="mortar")
+    with pytest.raises(_Killed):
+        dc.solve(killed_scene, dc.LoadControl(steps=3), checkpoint=path, on_step=on_step)
+    assert max(np.abs(itf.multiplier).max() for itf in killed_scene.interfaces) > 0.1 * P
+    resumed_scene, b_resumed, _ = _patch_scene(law, discretization="mortar")
+    resumed = dc.solve(resumed_scene, dc.LoadControl(steps=3), restart=path)
+    for col in ("iterations", "uzawa_updates", "cuts"):
+        np.testing.assert_array_equal(resumed.history.column(col), full.history.column(col), err_msg=col)
+    a, b = _nodal(b_full), _nodal(b_resumed)
+    assert max(np.abs(b[p] - u).max() for p, u in a.items()) < 1e-10 * P / E

@@ -345,6 +345,10 @@ class Interface:
             self.pairs_changed = True
         self.anchor = (xs.copy(), xm.copy())
 
+    def own_pairs(self, pairs: np.ndarray) -> np.ndarray:
+        """The pairs (k, 2) whose slave this rank evaluates."""
+        return pairs[np.isin(pairs[:, 0], self.mine)]
+
     def _candidate_pairs(self, xs, xm) -> np.ndarray:
         """(k, 2) [slave, master facet] of this rank's slaves near existing master facets."""
         pairs = self._broad_phase(xs[self.mine], xm)
@@ -828,7 +832,7 @@ class Contact(Contribution):
                 itf.initial_gap[:] = arrays[f"{k}_initial_gap"]
                 itf.gap_cancelled[:] = arrays[f"{k}_gap_cancelled"] > 0.5
             cand = arrays[f"{k}_candidates"].astype(np.int64).reshape(-1, 2)
-            itf.candidates = cand[np.isin(cand[:, 0], itf.mine)]
+            itf.candidates = itf.own_pairs(cand)
             itf.pairs_changed = True
             if f"{k}_kept" in arrays:
                 itf.restore_kept(arrays[f"{k}_kept"].astype(np.int64))

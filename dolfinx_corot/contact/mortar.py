@@ -90,6 +90,10 @@ class MortarInterface3D(Interface3D):
         k = self.slave.facets.shape[1]
         return xs[self.slave.facets[faces]].reshape(len(faces), k, 3).mean(axis=1)
 
+    def own_pairs(self, pairs: np.ndarray) -> np.ndarray:
+        """The pairs (k, 2) [slave face, master face] whose slave face this rank evaluates."""
+        return pairs[np.isin(pairs[:, 0], self.mine_faces)]
+
     def _candidate_pairs(self, xs, xm) -> np.ndarray:
         """(k, 2) [slave face, master face] of this rank's existing slave faces whose centre lies in
         the box of an existing master face inflated by the margin and the slave faces' size."""

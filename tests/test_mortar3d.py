@@ -187,30 +187,6 @@ def test_assembled_mortar_tangent_matches_finite_differences(symmetric):
     system.destroy()
 
 
-def test_an_idle_mortar_interface_leaves_the_solution_bit_identical():
-    """Effects on demand: the upper block 0.8 above the lower one and lifted, with and without a
-    mortar interface: bit-identical displacements, and no contact matrix built."""
-    from dolfinx_corot.assembly import make_system
-
-    states = []
-    for contact in (False, True):
-        sc = dc.Scene(large_rotations=False, linear_solver="direct")
-        b = sc.add_solid(_two_blocks(0.35, 0.45, 0.8), material=dc.Elastic(E, NU), degree=1)
-        sc.fix(b, "base", dofs=("uz",))
-        sc.fix(b, "x0", dofs=("ux",))
-        sc.fix(b, "y0", dofs=("uy",))
-        sc.prescribe(b, "top", uz=0.2)
-        if contact:
-            sc.contact((b, "upper_face"), (b, "lower_face"), symmetric=True, discretization="mortar")
-        system = make_system(sc.model, solver=sc.linear_solver, contributions=sc.contributions())
-        dc.solve(sc, dc.LoadControl(steps=2), system=system)
-        if contact:
-            assert system.C is None
-        system.destroy()
-        states.append(_nodal(b))
-    assert all(np.array_equal(states[1][p], u) for p, u in states[0].items())
-
-
 def test_mortar_input_is_checked_by_name():
     """Refused by name: an unknown discretization, mortar in 2D, mortar with a shell's surface."""
     from dolfinx_corot.io.gmsh_models import polyline

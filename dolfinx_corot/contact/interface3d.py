@@ -227,16 +227,8 @@ class Interface3D(Interface):
         if not self.comm.allreduce(len(self.candidates), op=MPI.SUM):  # nothing near: an idle interface
             n = len(self.area)
             self._assigned = (np.full(n, -1), np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), np.zeros(n))
-            self.active[:] = -1
             self.previous_face[:] = -1
-            none = np.zeros(0, dtype=np.int64)
-            if self.first_evaluation:
-                self.first_evaluation, self.had_contact = False, False
-            self._virtual = None
-            self._last = (none, np.zeros(0))
-            self._forces = (none, none, np.zeros((0, PAIR_DOFS)))
-            return (np.zeros((0, PAIR_DOFS), dtype=np.int64), np.zeros((0, PAIR_DOFS)),
-                    np.zeros((0, PAIR_DOFS, PAIR_DOFS)), (none, none))
+            return self._idle(PAIR_DOFS)
         self._assigned = self._assign(xs, xm, self.candidates, self.previous_face)
         face, mode, which, side = self._assigned
         self.previous_face = np.where(mode == 0, face, -1)
@@ -272,6 +264,17 @@ class Interface3D(Interface):
         self._x = (xs, xm)
         self._forces = (s[keep], m[keep], f[keep])
         return self.pair_dofs(s[keep], m[keep], free=False), f[keep], K[keep], (s[keep], m[keep])
+
+    def _idle(self, width: int):
+        """No candidate pair on any rank: no pair, no force, no tangent (blocks of ``width`` dofs)."""
+        none = np.zeros(0, dtype=np.int64)
+        self.active[:] = -1
+        if self.first_evaluation:
+            self.first_evaluation, self.had_contact = False, False
+        self._virtual = None
+        self._last = (none, np.zeros(0))
+        self._forces = (none, none, np.zeros((0, width)))
+        return np.zeros((0, width), dtype=np.int64), np.zeros((0, width)), np.zeros((0, width, width)), (none, none)
 
     def cancel_initial_gaps(self, slaves: np.ndarray | None = None) -> int:
         """Approach I of staged construction: each existing slave (of ``slaves``; None: all) that finds

@@ -143,17 +143,9 @@ class MortarInterface3D(Interface3D):
             self.evaluations = 0
         self._search(xs, xm)
         self._x = (xs, xm)
-        none = np.zeros(0, dtype=np.int64)
         if not self.comm.allreduce(len(self.candidates), op=MPI.SUM):  # nothing near: an idle interface
             self.weighted[:] = 0.0
-            self.active[:] = -1
-            if self.first_evaluation:
-                self.first_evaluation, self.had_contact = False, False
-            self._virtual = None
-            self._last = (none, np.zeros(0))
-            self._forces = (none, none, np.zeros((0, PAIR_DOFS)))
-            return (np.zeros((0, PAIR_DOFS), dtype=np.int64), np.zeros((0, PAIR_DOFS)),
-                    np.zeros((0, PAIR_DOFS, PAIR_DOFS)), (none, none))
+            return self._idle(PAIR_DOFS)
         # the touch band's stiffness only while no point of the interface was in contact at the last
         # evaluation (bodies touching without load): a stiffness without a force is not the
         # residual's derivative, and kept in the first evaluations of every solve as node-to-face

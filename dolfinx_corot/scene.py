@@ -321,7 +321,11 @@ class Scene:
         smooth (2D; default True): the master surface is the C¹ Hermite curve through its nodes
         (normals continuous from segment to segment: robust sliding over curved and deforming
         masters); False: the straight segments (slave forces shared linearly by the segment's two
-        nodes: the patch test is passed exactly). 3D: flat faces with edge and vertex contact.
+        nodes: the patch test is passed exactly). 3D (default False): flat faces with edge and
+        vertex contact; True: the faces with averaged nodal normals, each slave met along the
+        normal field they interpolate (gap, normal and force continuous from face to face:
+        smooth sliding over faceted curved masters; sharp features above 60° stay sharp;
+        :mod:`~dolfinx_corot.contact.smooth3d`).
 
         discretization (3D): 'node_to_face' (default; slave nodes against master faces, every
         kind of surface) or 'mortar' (segment-to-segment between two solids' faces: the contact

@@ -51,7 +51,7 @@ def _two_blocks(h_low: float, h_up: float, gap: float = 0.0, matching: bool = Fa
 
 
 def _patch_scene(law, symmetric: bool = True, matching: bool = False, discretization: str = "node_to_face",
-                 sizes: tuple[float, float] = (0.26, 0.35)):
+                 sizes: tuple[float, float] = (0.26, 0.35), smooth: bool = False):
     sc = dc.Scene(large_rotations=False, linear_solver="direct")
     tm = _two_blocks(sizes[0], sizes[0] if matching else sizes[1], matching=matching)
     b = sc.add_solid(tm, material=dc.Elastic(E, NU), degree=1)
@@ -60,7 +60,7 @@ def _patch_scene(law, symmetric: bool = True, matching: bool = False, discretiza
     sc.fix(b, "y0", dofs=("uy",))
     sc.load(b, "top", traction=(0.0, 0.0, -P))
     pair = sc.contact((b, "upper_face"), (b, "lower_face"), law=law, symmetric=symmetric,
-                      discretization=discretization)
+                      discretization=discretization, smooth=smooth)
     sc.monitor_contact("c", pair)
     return sc, b, pair
 
@@ -153,14 +153,16 @@ def test_two_pass_patch_test_is_exact_on_matching_faces_and_has_a_discrete_limit
 
 
 @pytest.mark.skipif(comm.size > 1, reason="dense finite differences of the assembled system: serial")
-@pytest.mark.parametrize("symmetric", [False, True])
-def test_assembled_3d_contact_tangent_matches_finite_differences(symmetric):
+@pytest.mark.parametrize("symmetric, smooth", [(False, False), (True, False), (True, True)])
+def test_assembled_3d_contact_tangent_matches_finite_differences(symmetric, smooth):
     """The system's tangent (blocks + contact) against central differences of its residual at a
     penetrating, sheared, randomly perturbed state, with augmented-Lagrangian multipliers
-    (slaves on faces, some beyond the border of the master surface): 1e-6 of the largest entry."""
+    (slaves on faces, some beyond the border of the master surface): 1e-6 of the largest entry.
+    With the smoothed masters the perturbation tilts every nodal normal: the tangent couples each
+    slave to the whole stencil of its face, and is not symmetric."""
     from dolfinx_corot.assembly import make_system
 
-    sc, b, pair = _patch_scene(dc.AugmentedLagrangian(), symmetric)
+    sc, b, pair = _patch_scene(dc.AugmentedLagrangian(), symmetric, smooth=smooth)
     for itf in sc.interfaces:
         itf.multiplier[:] = 0.3 * P
     system = make_system(sc.model, contributions=sc.contributions())
@@ -175,19 +177,21 @@ def test_assembled_3d_contact_tangent_matches_finite_differences(symmetric):
     K, Kfd = free_part(system, *tangent_and_fd(system, model.state.x.array, 1.0))
     assert sum(int((itf.active >= 0).sum()) for itf in sc.interfaces) > 10
     assert np.abs(K - Kfd).max() < 1e-6 * np.abs(K).max()
+    assert (np.abs(K - K.T).max() > 1e-6 * np.abs(K).max()) == smooth
     system.destroy()
 
 
 def test_3d_contact_input_is_checked_by_name():
-    """Refused by name: a group that is not a face group of the solid, the smoothed master (not yet
-    in 3D), a quadratic solid, and a 3D beam as the master (a beam meets faces by its nodes)."""
+    """Refused by name: a group that is not a face group of the solid, mortar contact on a smoothed
+    master, a quadratic solid, and a 3D beam as the master (a beam meets faces by its nodes)."""
     from dolfinx_corot.io.gmsh_models import polyline
 
     tm = _two_blocks(0.5, 0.5)
     sc = dc.Scene(large_rotations=False)
     b = sc.add_solid(tm, material=dc.Elastic(E, NU), degree=1)
-    with pytest.raises(dc.ContactError, match="smoothed master surface is not available yet"):
-        sc.contact((b, "upper_face"), (b, "lower_face"), smooth=True)
+    with pytest.raises(dc.ContactError, match="mortar contact 'upper_face -> lower_face': the pressure acts along "
+                                              "the slave faces' normals, a smoothed master surface does not apply"):
+        sc.contact((b, "upper_face"), (b, "lower_face"), smooth=True, discretization="mortar")
     with pytest.raises(ValueError, match="contact surface 'lower' is not a group of boundary faces"):
         sc.contact((b, "upper_face"), (b, "lower"))
     beam = sc.add_beam(polyline([[0.2, 0.2, 0.9], [0.8, 0.2, 0.9]], 2, gdim=3), "beam", section=dc.Rectangle(0.1, 0.1),

@@ -638,10 +638,14 @@ class Interface:
         return x, np.linalg.norm(total, axis=1) / length
 
 
-def _positive_part(K: np.ndarray) -> np.ndarray:
-    """The pair tangents (k, n, n) with their negative eigenvalues set to zero."""
+def _positive_part(K: np.ndarray, symmetric: bool = True) -> np.ndarray:
+    """The pair tangents (k, n, n) with their negative eigenvalues set to zero; an unsymmetric
+    tangent keeps its skew part, its symmetric part projected."""
+    skew = 0.0
+    if not symmetric:
+        K, skew = 0.5 * (K + K.transpose(0, 2, 1)), 0.5 * (K - K.transpose(0, 2, 1))
     lam, vec = np.linalg.eigh(K)
-    return np.einsum("kij,kj,klj->kil", vec, np.maximum(lam, 0.0), vec)
+    return np.einsum("kij,kj,klj->kil", vec, np.maximum(lam, 0.0), vec) + skew
 
 
 class Contact(Contribution):
@@ -717,7 +721,7 @@ class Contact(Contribution):
     def add_tangent(self, add) -> None:
         for itf, (K, (s, m)) in zip(self.interfaces, self._blocks):
             if len(s):
-                add(itf.pair_dofs(s, m), _positive_part(K) if self.project else K)
+                add(itf.pair_dofs(s, m), _positive_part(K, itf.SYMMETRIC_TANGENT) if self.project else K)
 
     def start_stage(self, approach: str) -> None:
         """Approach I: each slave meeting a master for the first time takes its gap as zero

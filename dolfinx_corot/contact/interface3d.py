@@ -35,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 from mpi4py import MPI
 
-from . import kernels3d
+from . import kernels3d, smooth3d
 from .interface import Interface
 from .laws import ContactError, Penalty
 from .search3d import broad_phase_boxes, face_boxes
@@ -71,21 +71,29 @@ class Interface3D(Interface):
     (each a (part, boundary group name) pair)."""
 
     FACETS = "faces"
-    master_surface = "flat master faces"
     INSIDE_TOLERANCE = 1e-9  # a projection this far (in the face's parameters) beyond an edge is on it
     FREE_EDGE_TOLERANCE = 0.05  # a solid's slave beyond the surface's border: this far (× the face) still on it
+    # on a smoothed master: a border node's normal averages the faces on one side (tilted outwards,
+    # e.g. at a symmetry plane), and the point along the normal field of a slave at the border
+    # falls beyond it by the gap × the tilt: the patch is extended by half a face there rather than
+    # handing the slave to the flat edge kernel, whose gap (to the chord) differs by the patch's bulge
+    SMOOTH_FREE_EDGE_TOLERANCE = 0.5
     TOUCH_EVALUATIONS = 8  # evaluations of a Newton solve with the touch band's stiffness whatever the pairs
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = False):
-        if smooth:
-            raise ContactError("3D contact: the smoothed master surface is not available yet; give smooth=False "
-                               "(flat faces with edge and vertex contact)")
         super().__init__(slaves, masters, law, smooth)
+        if self.smooth:  # along the smoothed normal field the force is not an energy's gradient
+            self.SYMMETRIC_TANGENT = False
         if self.slave.dim == 1:  # a beam's nodes: its share of length times the section's width
             self.area = self.area * 2.0 * self.slave_face
         self._virtual = None
         self.previous_face = np.full(len(self.area), -1)  # each slave's face at the last evaluation
         self.evaluations = 0  # of the current Newton solve
+
+    @property
+    def master_surface(self) -> str:
+        """The master surface the slaves meet, in words."""
+        return "smoothed master faces (averaged nodal normals)" if self.smooth else "flat master faces"
 
     def bind(self, system) -> None:
         super().bind(system)
@@ -123,6 +131,13 @@ class Interface3D(Interface):
         pairs = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], axis=2), axis=2).reshape(-1, 2)
         _, inverse, count = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
         self.free_edge = (count[inverse] == 1).reshape(len(faces), k)
+        # each pair's master nodes: the face's (flat), or its stencil: the face's nodes, then the
+        # other nodes of the faces around them, whose positions set its nodal normals (smooth)
+        if self.smooth:
+            self.ext, self.star, self.nstar = smooth3d.build_stencils(self.master.X, faces, self.SMOOTH_ANGLE)
+        else:
+            self.ext = np.where(np.arange(4) < self.nodes[:, None], self.faces, -1)
+        self.width = 3 * (1 + self.ext.shape[1])
 
     @staticmethod
     def _tributary(X: np.ndarray, facets: np.ndarray) -> np.ndarray:
@@ -133,12 +148,14 @@ class Interface3D(Interface):
 
     # -- pairs ------------------------------------------------------------------------------
     def pair_dofs(self, slaves: np.ndarray, faces: np.ndarray, free: bool = True) -> np.ndarray:
-        """Global dofs (k, 15) of slave–face pairs (slave, then the face's four nodes; a triangle's
-        fourth node −1, and with ``free`` the constrained dofs: PETSc skips them). The forces go to
-        all dofs (on a supported one they are part of its reaction), the tangent to the free ones."""
+        """Global dofs (k, width) of slave–face pairs (slave, then the face's four nodes, a triangle's
+        fourth −1; on a smoothed master then the rest of the face's stencil, −1 padded; with
+        ``free`` the constrained dofs −1 too: PETSc skips them). The forces go to all dofs (on a
+        supported one they are part of its reaction), the tangent to the free ones."""
         gd = self.master_gdofs
-        dofs = np.hstack([self.slave_gdofs[slaves]] + [gd[self.faces[faces, j]] for j in range(4)])
-        dofs[:, 12:][self.nodes[faces] == 3] = -1
+        ext = self.ext[faces]
+        dofs = np.hstack([self.slave_gdofs[slaves]] + [np.where(ext[:, j:j + 1] >= 0, gd[ext[:, j]], -1)
+                                                       for j in range(ext.shape[1])])
         if free:
             dofs[np.isin(dofs, self.constrained)] = -1
         return dofs
@@ -166,7 +183,14 @@ class Interface3D(Interface):
         k = len(pairs)
         xi, eta, dist = np.zeros(k), np.zeros(k), np.zeros(k)
         on = np.zeros(k, dtype=bool)
-        kernels3d.closest_on_faces(xs, xm, self.faces, self.nodes, s, m, self.INSIDE_TOLERANCE, xi, eta, dist, on)
+        if self.smooth:  # the point along the normal field, on the face within the tolerance
+            smooth3d.smooth_on_faces(xs, xm, self.ext, self.nodes, self.star, self.nstar, s, m, xi, eta, dist, on)
+            tol = self.INSIDE_TOLERANCE
+            three = self.nodes[m] == 3
+            on &= np.where(three, (xi >= -tol) & (eta >= -tol) & (xi + eta <= 1.0 + tol),
+                           (np.abs(xi) <= 1.0 + tol) & (np.abs(eta) <= 1.0 + tol))
+        else:
+            kernels3d.closest_on_faces(xs, xm, self.faces, self.nodes, s, m, self.INSIDE_TOLERANCE, xi, eta, dist, on)
         sides = np.where(dist < 0.0, -1.0, 1.0) if self.two_sided else np.zeros(k)
         offset = self.slave_offset[s] + self.master_offset[m]
         g = (np.abs(dist) if self.two_sided else dist) - offset
@@ -214,7 +238,8 @@ class Interface3D(Interface):
             over = 0.5 * np.column_stack([-1.0 - eta, xi - 1.0, eta - 1.0, -1.0 - xi])
         free = self.free_edge[m]
         inner_ok = np.all(np.where(free, True, over <= self.INSIDE_TOLERANCE), axis=1)
-        return inner_ok & np.all(over <= self.FREE_EDGE_TOLERANCE, axis=1) & np.any(free & (over > 0.0), axis=1)
+        tolerance = self.SMOOTH_FREE_EDGE_TOLERANCE if self.smooth else self.FREE_EDGE_TOLERANCE
+        return inner_ok & np.all(over <= tolerance, axis=1) & np.any(free & (over > 0.0), axis=1)
 
     def evaluate(self):
         """Forces and tangents of this rank's slaves at the current configuration: (dofs (k, 15)
@@ -228,7 +253,7 @@ class Interface3D(Interface):
             n = len(self.area)
             self._assigned = (np.full(n, -1), np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64), np.zeros(n))
             self.previous_face[:] = -1
-            return self._idle(PAIR_DOFS)
+            return self._idle(self.width)
         self._assigned = self._assign(xs, xm, self.candidates, self.previous_face)
         face, mode, which, side = self._assigned
         self.previous_face = np.where(mode == 0, face, -1)
@@ -236,14 +261,8 @@ class Interface3D(Interface):
         m = face[s]
         self.active[:] = -1
         self.active[s] = m
-        n = len(s)
-        g = np.zeros(n)
-        f = np.zeros((n, PAIR_DOFS))
-        K = np.zeros((n, PAIR_DOFS, PAIR_DOFS))
         lam = self.multiplier[s]
-        offset = self.slave_offset[s] + self.master_offset[m]
-        kernels3d.pairs_to_faces(xs, xm, self.faces, self.nodes, s, m, mode[s], which[s], side[s], offset, lam,
-                                 np.full(n, self.penalty), self.area[s], True, g, f, K, self.touch)
+        g, f, K = self._pairs(xs, xm, s, m, mode[s], which[s], side[s], lam, True)
         if self.first_evaluation:
             self.first_evaluation = False
             self.had_contact = bool(self.comm.allreduce(int(np.any(lam - self.penalty * g > 0.0)), op=MPI.MAX))
@@ -264,6 +283,32 @@ class Interface3D(Interface):
         self._x = (xs, xm)
         self._forces = (s[keep], m[keep], f[keep])
         return self.pair_dofs(s[keep], m[keep], free=False), f[keep], K[keep], (s[keep], m[keep])
+
+    def _pairs(self, xs, xm, s, m, mode, which, side, lam, tangent: bool):
+        """Gaps (n,), forces (n, width) and (``tangent``) tangents (n, width, width) of pairs (slave
+        s, face m) in ``mode`` at ``which`` on ``side``: flat faces' kernels (:mod:`.kernels3d`);
+        on a smoothed master the normal field's (:mod:`.smooth3d`) over the faces, the flat
+        kernels at the edges and vertices of the surface's border."""
+        n = len(s)
+        g, f, K = np.zeros(n), np.zeros((n, self.width)), np.zeros((n, self.width, self.width))
+        offset = self.slave_offset[s] + self.master_offset[m]
+        eps = np.full(n, self.penalty)
+        flat = np.flatnonzero(mode != 0) if self.smooth else np.arange(n)
+        if len(flat):
+            i = flat
+            gi, fi, Ki = np.zeros(len(i)), np.zeros((len(i), PAIR_DOFS)), np.zeros((len(i), PAIR_DOFS, PAIR_DOFS))
+            kernels3d.pairs_to_faces(xs, xm, self.faces, self.nodes, s[i], m[i], mode[i], which[i], side[i], offset[i],
+                                     lam[i], eps[i], self.area[s[i]], tangent, gi, fi, Ki, self.touch)
+            g[i], f[i, :PAIR_DOFS] = gi, fi
+            K[i, :PAIR_DOFS, :PAIR_DOFS] = Ki
+        if self.smooth:
+            i = np.flatnonzero(mode == 0)
+            gi, fi, Ki = np.zeros(len(i)), np.zeros((len(i), self.width)), np.zeros((len(i), self.width, self.width))
+            smooth3d.pairs_to_smooth_faces(xs, xm, self.ext, self.nodes, self.star, self.nstar, s[i], m[i], side[i],
+                                           offset[i], lam[i], eps[i], self.area[s[i]], tangent, gi, fi, Ki,
+                                           self.touch)
+            g[i], f[i], K[i] = gi, fi, Ki
+        return g, f, K
 
     def _idle(self, width: int):
         """No candidate pair on any rank: no pair, no force, no tangent (blocks of ``width`` dofs)."""
@@ -288,13 +333,8 @@ class Interface3D(Interface):
             s = s[np.isin(s, slaves)]
         g, done = np.zeros(len(self.area)), np.zeros(len(self.area))
         if len(s):
-            n = len(s)
-            gs = np.zeros(n)
-            kernels3d.pairs_to_faces(xs, xm, self.faces, self.nodes, s, face[s], mode[s], which[s], side[s],
-                                     self.slave_offset[s] + self.master_offset[face[s]], np.zeros(n),
-                                     np.full(n, self.penalty), self.area[s], False, gs, np.zeros((n, PAIR_DOFS)),
-                                     np.zeros((n, PAIR_DOFS, PAIR_DOFS)))
-            g[s], done[s] = gs, 1.0
+            g[s] = self._pairs(xs, xm, s, face[s], mode[s], which[s], side[s], np.zeros(len(s)), False)[0]
+            done[s] = 1.0
         return self._take_initial_gaps(g, done)
 
     def project_slaves(self, slaves: np.ndarray) -> np.ndarray:
@@ -342,9 +382,9 @@ class Interface3D(Interface):
             np.add.at(out, s, f[:, :3])
             return out
         out = np.zeros((len(self.master.X), 3))
-        for j in range(4):
-            real = j < self.nodes[m]
-            np.add.at(out, self.faces[m[real], j], f[real, 3 + 3 * j: 6 + 3 * j])
+        for j in range(self.ext.shape[1]):
+            real = self.ext[m, j] >= 0
+            np.add.at(out, self.ext[m[real], j], f[real, 3 + 3 * j: 6 + 3 * j])
         return out
 
     def master_pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -357,5 +397,5 @@ class Interface3D(Interface):
 
     def describe(self) -> dict:
         return {"slaves": self.slave_spec[1], "masters": self.master_spec[1], "law": repr(self.law),
-                "smooth": False, "penalty": self.penalty, "slave_nodes": len(self.area),
+                "smooth": self.smooth, "penalty": self.penalty, "slave_nodes": len(self.area),
                 "master_segments": len(self.master.facets)}

@@ -41,6 +41,10 @@ class MortarInterface3D(Interface3D):
     TOUCH_BAND = 1e-2  # × the mean master edge
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = False):
+        if smooth:
+            raise ContactError(f"mortar contact '{slaves[1]} -> {masters[1]}': the pressure acts along the slave "
+                               "faces' normals, a smoothed master surface does not apply: give smooth=False (or "
+                               "discretization='node_to_face' with smooth=True)")
         super().__init__(slaves, masters, law, smooth)
         for (part, group), surf, role in ((slaves, self.slave, "slaves"), (masters, self.master, "masters")):
             if surf.dim != 2 or surf.two_sided:

@@ -73,11 +73,6 @@ class Interface3D(Interface):
     FACETS = "faces"
     INSIDE_TOLERANCE = 1e-9  # a projection this far (in the face's parameters) beyond an edge is on it
     FREE_EDGE_TOLERANCE = 0.05  # a solid's slave beyond the surface's border: this far (× the face) still on it
-    # on a smoothed master: a border node's normal averages the faces on one side (tilted outwards,
-    # e.g. at a symmetry plane), and the point along the normal field of a slave at the border
-    # falls beyond it by the gap × the tilt: the patch is extended by half a face there rather than
-    # handing the slave to the flat edge kernel, whose gap (to the chord) differs by the patch's bulge
-    SMOOTH_FREE_EDGE_TOLERANCE = 0.5
     TOUCH_EVALUATIONS = 8  # evaluations of a Newton solve with the touch band's stiffness whatever the pairs
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = False):
@@ -238,8 +233,7 @@ class Interface3D(Interface):
             over = 0.5 * np.column_stack([-1.0 - eta, xi - 1.0, eta - 1.0, -1.0 - xi])
         free = self.free_edge[m]
         inner_ok = np.all(np.where(free, True, over <= self.INSIDE_TOLERANCE), axis=1)
-        tolerance = self.SMOOTH_FREE_EDGE_TOLERANCE if self.smooth else self.FREE_EDGE_TOLERANCE
-        return inner_ok & np.all(over <= tolerance, axis=1) & np.any(free & (over > 0.0), axis=1)
+        return inner_ok & np.all(over <= self.FREE_EDGE_TOLERANCE, axis=1) & np.any(free & (over > 0.0), axis=1)
 
     def evaluate(self):
         """Forces and tangents of this rank's slaves at the current configuration: (dofs (k, 15)

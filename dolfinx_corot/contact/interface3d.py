@@ -22,6 +22,11 @@ evaluates the slaves whose x dof it owns. At each evaluation
 3. the kernels give the pair's gap, force and tangent (15 dofs: the slave, then four face nodes;
    a triangle's fourth is none).
 
+With ``smooth=True`` the master faces are Nagata patches through averaged nodal normals and each
+slave meets them along the normal field those interpolate (:mod:`.smooth3d`): a pair's dofs are
+then the slave and the face's stencil (the nodes of the faces around the face's nodes), and a
+slave beyond the surface's border meets its edges and vertices with the flat kernels.
+
 A shell's mid-surface is a two-sided master: a slave meets the face at half the thickness on its
 own side (the side of the mid-surface it is on), and a shell's free edge as a rounded edge. A 3D
 beam meets faces by its nodes, each a sphere of the section's outer radius.
@@ -236,8 +241,9 @@ class Interface3D(Interface):
         return inner_ok & np.all(over <= self.FREE_EDGE_TOLERANCE, axis=1) & np.any(free & (over > 0.0), axis=1)
 
     def evaluate(self):
-        """Forces and tangents of this rank's slaves at the current configuration: (dofs (k, 15)
-        global, f (k, 15), K (k, 15, 15), (slave, face) (k,)) over the pairs in contact."""
+        """Forces and tangents of this rank's slaves at the current configuration: (dofs (k, width)
+        global, f (k, width), K (k, width, width), (slave, face) (k,)) over the pairs in contact
+        (width 15 on flat faces, 3 (1 + stencil) on a smoothed master)."""
         xs, xm = self._positions(self.slave), self._positions(self.master)
         if self.first_evaluation:  # a Newton solve starts
             self.evaluations = 0

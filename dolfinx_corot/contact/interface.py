@@ -142,6 +142,11 @@ class Interface:
         """The master surface the slaves meet, in words."""
         return "smooth master curve" if self.smooth else "straight master segments"
 
+    @property
+    def symmetric_tangent(self) -> bool:
+        """Whether the pairs' tangents are symmetric (the Hessians of their energies)."""
+        return self.SYMMETRIC_TANGENT
+
     @staticmethod
     def _tributary(X: np.ndarray, facets: np.ndarray) -> np.ndarray:
         """(n,) each node's share of the surface: its tributary length of the segments."""
@@ -685,7 +690,7 @@ class Contact(Contribution):
     def symmetric_tangent(self) -> bool:
         """Node-to-segment and node-to-face tangents are the Hessians of the pairs' energies;
         mortar tangents are not symmetric."""
-        return all(itf.SYMMETRIC_TANGENT for itf in self.interfaces)
+        return all(itf.symmetric_tangent for itf in self.interfaces)
 
     # -- couplings and assembly ---------------------------------------------------------
     @property
@@ -721,7 +726,7 @@ class Contact(Contribution):
     def add_tangent(self, add) -> None:
         for itf, (K, (s, m)) in zip(self.interfaces, self._blocks):
             if len(s):
-                add(itf.pair_dofs(s, m), _positive_part(K, itf.SYMMETRIC_TANGENT) if self.project else K)
+                add(itf.pair_dofs(s, m), _positive_part(K, itf.symmetric_tangent) if self.project else K)
 
     def start_stage(self, approach: str) -> None:
         """Approach I: each slave meeting a master for the first time takes its gap as zero

@@ -82,8 +82,6 @@ class Interface3D(Interface):
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = False):
         super().__init__(slaves, masters, law, smooth)
-        if self.smooth:  # along the smoothed normal field the force is not an energy's gradient
-            self.SYMMETRIC_TANGENT = False
         if self.slave.dim == 1:  # a beam's nodes: its share of length times the section's width
             self.area = self.area * 2.0 * self.slave_face
         self._virtual = None
@@ -94,6 +92,11 @@ class Interface3D(Interface):
     def master_surface(self) -> str:
         """The master surface the slaves meet, in words."""
         return "smoothed master faces (averaged nodal normals)" if self.smooth else "flat master faces"
+
+    @property
+    def symmetric_tangent(self) -> bool:
+        """Along a smoothed master's normal field the force is not an energy's gradient."""
+        return self.SYMMETRIC_TANGENT and not self.smooth
 
     def bind(self, system) -> None:
         super().bind(system)

@@ -1,29 +1,34 @@
-r"""Node-to-face contact against a smoothed master surface in 3D: averaged nodal normals and the
-normal field they interpolate.
+r"""Node-to-face contact against a smoothed master surface in 3D: averaged nodal normals, the
+Nagata patches through them and the normal field they interpolate.
 
 Each master node a of a face carries the unit normal n_a = s_a/|s_a|, s_a = Σ_f c_f the sum of
 the area vectors of the faces around it (c_f = (x_2 − x_1) × (x_3 − x_1) for a triangle, the
 cross product of the diagonals (x_3 − x_1) × (x_4 − x_2) for a quadrilateral; twice the area
 times the unit normal), taken over the faces whose normal in the reference configuration lies
 within the smoothing angle of the face's own: across a sharp feature (a block's corner edge)
-each side keeps its own normals. The normal field over the face is n̄(ξ) = Σ N_a(ξ) n_a and
-the slave's contact point is found along it, not along the shortest distance (the "normal field
-projection"; Puso & Laursen 2004 and Popp et al. 2009 project along averaged nodal normals in
-their mortar methods; Wriggers 2006, §9.1.2):
+each side keeps its own normals. The face is the Nagata patch x(ξ) = Σ N_a x_a − Σ_e c_e B_e
+through its nodes and their normals (:func:`surface`; Nagata 2005, Neto et al. 2014). The normal
+field over it is n̄(ξ) = Σ N_a(ξ) n_a, and the slave's contact point is found along it, not
+along the shortest distance (the "normal field projection"; Puso & Laursen 2004 and Popp et al.
+2009 project along averaged nodal normals in their mortar methods; Wriggers 2006, §9.1.2):
 
-    x_s = Σ N_a(ξ) x_a + t n̄(ξ),   three equations for (ξ, η, t),
+    x_s = x(ξ) + t n̄(ξ),   three equations for (ξ, η, t),
 
 solved by Newton from the flat closest point. The gap is g = t |n̄| − offset (the distance along
 the unit normal ν = n̄/|n̄|), the pressure p = ⟨λ − ε g⟩ and the forces act along ν:
 
-    f_s = −A p ν,   f_a = A p N_a ν   (a = the face's nodes).
+    f_s = −A p ν,   f_a = A p w_a ν   (a = the face's nodes),
 
-Both sum to zero and their moment vanishes (x_s − Σ N_a x_a = t n̄ is parallel to ν), so the
-pair conserves linear and angular momentum. On a shared edge the point, the normal field and
+with w the shape functions where the line x(ξ) + s ν meets the flat face (:func:`_weights`).
+The forces sum to zero and their moment vanishes (x_s − Σ w_a x_a is parallel to ν), so the
+pair conserves linear and angular momentum. On a shared edge the patch, the normal field and
 so g and ν depend only on the edge's two nodes and their normals: a slave crossing from face to
 face sees its gap, normal and force pass continuously — no jump of the force direction at the
-edges of a faceted curved master, whose normal turns by the angle between the faces. On a flat
-surface all normals are the face's and the kernel is the flat one's (the patch test holds).
+edges of a faceted curved master, whose normal turns by the angle between the faces (the
+master nodes' shares w differ between the two faces by the distance, along ν, of the curved
+edge from the flat faces' planes: 1e-5 of the force in the tests). On a flat surface all
+normals are the face's, every c_e vanishes and the kernel is the flat one's (the patch test
+holds).
 
 The force is not the gradient of an energy (the gap's derivatives with respect to ξ do not drop
 out along a normal field other than the face's), so its exact derivative K = ∂f/∂x is not
@@ -45,6 +50,23 @@ import numpy as np
 from .kernels3d import H, project, shape
 
 _NEWTON_ITERATIONS = 30
+
+
+@numba.njit(cache=True)
+def _triple(a, b, c):
+    """a · (b × c)."""
+    return (a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+            a[2] * (b[0] * c[1] - b[1] * c[0]))
+
+
+@numba.njit(cache=True)
+def _normal_field(k, N, nn, out):
+    """n̄ = Σ N_a n_a into out (3,); returns |n̄|."""
+    for d in range(3):
+        out[d] = 0.0
+        for a in range(k):
+            out[d] += N[a] * nn[a, d]
+    return np.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2])
 
 
 @numba.njit(cache=True)
@@ -146,9 +168,10 @@ def surface(x, k, nn, xi, eta, xc, t1, t2):
 
 @numba.njit(cache=True)
 def normal_point(x, k, nn, xi, eta, t):
-    """(ξ, η, t, converged) with x_s = Σ N_a x_a + t Σ N_a n_a (the slave x[0], the face's nodes
-    x[1 … k], their normals nn), by Newton from (ξ, η, t) (steps at most the face's size); in the
-    dtype of x (complex for the complex step: two more iterations for the imaginary part)."""
+    """(ξ, η, t, converged) with x_s = x(ξ) + t Σ N_a n_a (the slave x[0], x(ξ) the point of the
+    Nagata patch of the face's nodes x[1 … k] and their normals nn, :func:`surface`), by Newton
+    from (ξ, η, t) (steps at most the face's size); in the dtype of x (complex for the complex
+    step: two more iterations for the imaginary part)."""
     dt = x.dtype
     N = np.empty(k, dtype=dt)
     dN = np.empty((k, 2), dtype=dt)
@@ -169,22 +192,12 @@ def normal_point(x, k, nn, xi, eta, t):
                 a2[d] += dN[a, 1] * t * nn[a, d]
                 a3[d] += N[a] * nn[a, d]
         # Cramer's rule for J (dξ, dη, dt) = −F, J = [a1 a2 a3]
-        c23x = a2[1] * a3[2] - a2[2] * a3[1]
-        c23y = a2[2] * a3[0] - a2[0] * a3[2]
-        c23z = a2[0] * a3[1] - a2[1] * a3[0]
-        det = a1[0] * c23x + a1[1] * c23y + a1[2] * c23z
+        det = _triple(a1, a2, a3)
         if det.real == 0.0:
             return xi, eta, t, False
-        dxi = -(F[0] * c23x + F[1] * c23y + F[2] * c23z) / det
-        # a1 · (F × a3) and a1 · (a2 × F), with −F
-        dxa = F[1] * a3[2] - F[2] * a3[1]
-        dya = F[2] * a3[0] - F[0] * a3[2]
-        dza = F[0] * a3[1] - F[1] * a3[0]
-        deta = -(a1[0] * dxa + a1[1] * dya + a1[2] * dza) / det
-        dxb = a2[1] * F[2] - a2[2] * F[1]
-        dyb = a2[2] * F[0] - a2[0] * F[2]
-        dzb = a2[0] * F[1] - a2[1] * F[0]
-        dtt = -(a1[0] * dxb + a1[1] * dyb + a1[2] * dzb) / det
+        dxi = -_triple(F, a2, a3) / det
+        deta = -_triple(a1, F, a3) / det
+        dtt = -_triple(a1, a2, F) / det
         step = abs(dxi.real) + abs(deta.real)
         if step > 1.0:
             dxi /= step
@@ -212,15 +225,12 @@ def start_point(x, k, nn):
     t1 = np.empty(3, dtype=x.dtype)
     t2 = np.empty(3, dtype=x.dtype)
     surface(x, k, nn, xi, eta, xc, t1, t2)
+    nb = np.empty(3, dtype=x.dtype)
+    norm = _normal_field(k, N, nn, nb)
     num = x[0, 0] * 0.0
-    den = num
     for d in range(3):
-        nb = num * 0.0
-        for a in range(k):
-            nb += N[a] * nn[a, d]
-        num += (x[0, d] - xc[d]) * nb
-        den += nb * nb
-    return xi, eta, num / den
+        num += (x[0, d] - xc[d]) * nb[d]
+    return xi, eta, num / (norm * norm)
 
 
 @numba.njit(cache=True)
@@ -246,11 +256,9 @@ def _weights(x, k, xc, nu, xi, eta, N):
                 a1[d] += dN[a, 0] * x[1 + a, d]
                 a2[d] += dN[a, 1] * x[1 + a, d]
         # J (dξ, dη, ds) = −r with J = [a1 a2 −ν]: Cramer's rule for dξ, dη
-        c2x, c2y, c2z = a2[1] * nu[2] - a2[2] * nu[1], a2[2] * nu[0] - a2[0] * nu[2], a2[0] * nu[1] - a2[1] * nu[0]
-        det = -(a1[0] * c2x + a1[1] * c2y + a1[2] * c2z)
-        dxi = (r[0] * c2x + r[1] * c2y + r[2] * c2z) / det
-        cx, cy, cz = r[1] * nu[2] - r[2] * nu[1], r[2] * nu[0] - r[0] * nu[2], r[0] * nu[1] - r[1] * nu[0]
-        deta = (a1[0] * cx + a1[1] * cy + a1[2] * cz) / det
+        det = -_triple(a1, a2, nu)
+        dxi = _triple(r, a2, nu) / det
+        deta = _triple(a1, r, nu) / det
         xi += dxi
         eta += deta
         if abs(dxi.real) + abs(deta.real) < 1e-13:
@@ -272,11 +280,7 @@ def _force(x, k, star, nstar, side, offset, lam, eps, area, xi0, eta0, t0, f):
     dN = np.empty((k, 2), dtype=dt)
     shape(k, xi, eta, N, dN)
     nu = np.empty(3, dtype=dt)
-    for d in range(3):
-        nu[d] = 0.0
-        for a in range(k):
-            nu[d] += N[a] * nn[a, d]
-    norm = np.sqrt(nu[0] * nu[0] + nu[1] * nu[1] + nu[2] * nu[2])
+    norm = _normal_field(k, N, nn, nu)
     sign = -1.0 if side < 0.0 else 1.0
     for d in range(3):
         nu[d] = sign * nu[d] / norm
@@ -383,12 +387,9 @@ def smooth_on_faces(xs, xm, ext, nodes, star, nstar, s, m, out_xi, out_eta, out_
         N = np.empty(k)
         dN = np.empty((k, 2))
         shape(k, xi, eta, N, dN)
-        nb = np.zeros(3)
-        for a in range(k):
-            nb += N[a] * nn[a]
         out_xi[i] = xi
         out_eta[i] = eta
-        out_dist[i] = t * np.sqrt(nb[0] * nb[0] + nb[1] * nb[1] + nb[2] * nb[2])
+        out_dist[i] = t * _normal_field(k, N, nn, np.empty(3))
         out_ok[i] = ok
 
 

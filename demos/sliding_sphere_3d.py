@@ -29,8 +29,8 @@
 # * equilibrium: the die's support reaction balances the contact force at every step (1e-8);
 # * smoothed master: over the steady part of the slide (the die's centre from x = 0.3 to 1.2)
 #   the vertical and the horizontal reaction depart from their linear trends by less than 2 % of
-#   the mean vertical one (issue 15's bound for "no spikes"); measured 0.49 % and 0.18 % on the
-#   CI mesh, 0.26 % and 0.09 % on the fine one;
+#   the mean vertical one (issue 15's bound for "no spikes"); measured 0.53 % and 0.17 % on the
+#   CI mesh, 0.24 % and 0.08 % on the fine one;
 # * flat master: the horizontal reaction's departures are several times larger (measured 1.75 %
 #   and 0.48 %; checked: at least three times the smoothed master's), the vertical one's 0.8 %
 #   and 0.47 %. The slave nodes entering and leaving the contact zone account for much of the
@@ -74,7 +74,7 @@ def mesh(h_block: float, h_die: float = 0.25):
         gmsh.model.add("ironing")
         occ = gmsh.model.occ
         sphere = occ.addSphere(0, 0, R, R)
-        occ.rotate([(3, sphere)], 0, 0, R, 1, 0, 0, np.pi / 2)  # its poles away from the contact (fans of thin faces)
+        occ.rotate([(3, sphere)], 0, 0, R, 1, 0, 0, np.pi / 2)  # its poles (fans of thin faces) away from the contact
         ball, _ = occ.intersect([(3, sphere)], [(3, occ.addBox(-R, 0, 0, 2 * R, R, R))])
         block = occ.addBox(X0, 0, -HEIGHT, X1 - X0, WIDTH, HEIGHT)
         occ.synchronize()

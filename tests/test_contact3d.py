@@ -178,7 +178,7 @@ def test_assembled_3d_contact_tangent_matches_finite_differences(symmetric, smoo
     u += rng.uniform(-1e-3, 1e-3, u.shape)
     K, Kfd = free_part(system, *tangent_and_fd(system, model.state.x.array, 1.0))
     assert sum(int((itf.active >= 0).sum()) for itf in sc.interfaces) > 10
-    assert np.abs(K - Kfd).max() < (1e-4 if smooth else 1e-6) * np.abs(K).max()
+    assert np.abs(K - Kfd).max() < 1e-6 * np.abs(K).max()
     assert (np.abs(K - K.T).max() > 1e-4 * np.abs(K).max()) == smooth
     system.destroy()
 
@@ -314,3 +314,95 @@ def test_a_touching_pair_keeps_its_stiffness_only_in_the_first_evaluations_once_
     assert kept == [True] * Interface3D.TOUCH_EVALUATIONS + [False, False]
     assert len(s) > 10  # the others closed
     system.destroy()
+
+
+def _slider_3d(quad: bool):
+    """A base block [0, 3] × [0, 2] × [0, 0.5] with a coarse structured top (faces 0.5: squares, or
+    each split in two triangles) and a slider [0.5, 1.5] × [0.5, 1.5] × [0.5, 1] of spacing 0.25
+    on it, not joined: groups 'base', 'base_top', 'slider_bottom', 'top'. The slider's nodes sit
+    over the base's vertices and edge midpoints."""
+    if comm.rank == 0:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        occ = gmsh.model.occ
+        vols = {"base_block": occ.addBox(0, 0, 0, 3, 2, 0.5), "slider": occ.addBox(0.5, 0.5, 0.5, 1, 1, 0.5)}
+        occ.synchronize()
+        groups = {}
+        for name, vol in vols.items():
+            h = 0.5 if name == "base_block" else 0.25  # the spacing in plan; two layers through the height
+            faces = [tag for _, tag in gmsh.model.getBoundary([(3, vol)], oriented=False)]
+            for _, curve in gmsh.model.getBoundary([(2, f) for f in faces], combined=False, oriented=False):
+                x0, y0, z0, x1, y1, z1 = gmsh.model.getBoundingBox(1, abs(curve))
+                n = 2 if z1 - z0 > 0.1 else int(round(max(x1 - x0, y1 - y0) / h))
+                gmsh.model.mesh.setTransfiniteCurve(abs(curve), n + 1)
+            for tag in faces:
+                gmsh.model.mesh.setTransfiniteSurface(tag)
+                if quad:
+                    gmsh.model.mesh.setRecombine(2, tag)
+                z = occ.getCenterOfMass(2, tag)[2]
+                face = ("base" if z < 1e-9 else "top" if z > 1 - 1e-9 else None if abs(z - 0.5) > 1e-9 else
+                        "base_top" if name == "base_block" else "slider_bottom")
+                if face:
+                    groups[face] = [tag]
+            gmsh.model.mesh.setTransfiniteVolume(vol)
+            if quad:
+                gmsh.model.mesh.setRecombine(3, vol)
+            gmsh.model.setPhysicalName(3, gmsh.model.addPhysicalGroup(3, [vol]), name)
+        for name, tags in groups.items():
+            gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, tags), name)
+        gmsh.model.mesh.generate(3)
+    tm = from_gmsh(gmsh.model, 3, comm=comm)
+    if comm.rank == 0:
+        gmsh.finalize()
+    return tm
+
+
+def _slider_scene(tm, press: float, contact: bool = True):
+    """The slider on the base (two-pass augmented Lagrangian, Uzawa to 1e-7 of a face: the
+    settlement is 5e-5), its top prescribed: settled by the uniaxial strain of a pressure ``press``
+    in the first of 17 steps, then moved by (1, 0.5); without ``contact`` the slider alone with
+    its bottom on rollers (the rigid frictionless flat; the base unloaded)."""
+    sc = dc.Scene(large_rotations=True, linear_solver="direct")
+    b = sc.add_solid(tm, "slider", material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+    sc.prescribe(b, "top", amplitude=dc.Amplitude(((0.0, 0.0), (1 / 17, 1.0), (1.0, 1.0))),
+                 uz=-press * 0.5 / E if press else 0.0)
+    sc.add_solid(tm, "base_block", material=dc.SaintVenantKirchhoff(1000 * E, NU), degree=1)
+    sc.fix(b, "base")
+    if contact:
+        sc.prescribe(b, "top", ux=1.0, uy=0.5)
+        sc.contact((b, "slider_bottom"), (b, "base_top"), law=dc.AugmentedLagrangian(gap_tolerance=1e-7),
+                   symmetric=True)
+    else:
+        sc.prescribe(b, "top", ux=0.0, uy=0.0)
+        sc.fix(b, "slider_bottom", dofs=("uz",))
+    sc.monitor_reaction("top", b, "top")
+    return sc
+
+
+@pytest.mark.parametrize("quad", [False, True], ids=["triangles", "quadrilaterals"])
+@pytest.mark.parametrize("press", [0.01, 0.0], ids=["pressed", "grazing"])
+def test_a_block_slides_over_the_edges_and_vertices_of_a_coarse_master(quad, press):
+    """Hard case: a slider (spacing 0.25) pushed by its top by (1, 0.5) over a base 1000 times
+    stiffer whose top has faces of 0.5 (squares or triangles), pressed by a settlement of its top
+    or only touching (grazing: zero gaps throughout). On the way its bottom nodes cross the base's
+    edges and sit exactly on its vertices and edges (at the travels (0.5, 0.25) and (1, 0.5)), and
+    the base's nodes pass under the border of the slider's bottom. Without friction, on a base
+    this stiff, contact is the rigid frictionless flat: the normal force equals that of the slider
+    on rollers at every step (0.3 %; measured 0.07 %: the base's compliance, 1e-3 of the slider's), the horizontal
+    forces are nil (1e-5 of it; measured 3e-8); grazing, every force vanishes (1e-12). Every step
+    converges without a cut (at most 20 Newton iterations over its two Uzawa updates). Before
+    slaves beyond the border of a solid's surface met its edges from outside only, a base node a
+    hair below the slider's bottom and beside it counted as penetrating by its distance to the
+    edge, and no step converged."""
+    tm = _slider_3d(quad)
+    h = dc.solve(_slider_scene(tm, press), dc.LoadControl(steps=17)).history
+    assert h.column("cuts").sum() == 0
+    assert h.column("iterations").max() <= 20, h.column("iterations")
+    Fz = h.column("top_Fz")
+    Ft = np.hypot(h.column("top_Fx"), h.column("top_Fy"))
+    if press:
+        rollers = dc.solve(_slider_scene(tm, press, contact=False), dc.LoadControl(steps=1)).history.column("top_Fz")
+        assert np.abs(Fz / rollers[-1] - 1.0).max() < 3e-3, (Fz, rollers)
+        assert Ft.max() < 1e-5 * abs(Fz).max(), Ft
+    else:
+        assert np.abs(Fz).max() < 1e-12 and Ft.max() < 1e-12

@@ -88,6 +88,30 @@ def test_two_sided_master_with_a_shell_offset(k, mode, which, slave, side):
 
 
 @pytest.mark.parametrize("k", [3, 4])
+@pytest.mark.parametrize("mode, which", [(1, 0), (2, 0)])
+def test_beyond_the_border_of_a_solid_a_slave_is_inside_only_below_the_45_degree_line(k, mode, which):
+    """A one-sided master's border edge (mode 1) or vertex (2), ``side`` BORDER: a slave beyond it
+    by d and below the face's plane by δ has the gap +|x_s − x_c| (outside: beside the body) for
+    δ < d, whatever the sign of δ — at the face's level (grazing) too, where the sign of the face
+    normal's component is round-off — and −|x_s − x_c| for δ > d (sunk below a border shared with
+    another body); there the force and tangent are the energy's derivatives."""
+    face = (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float) if k == 3 else
+            np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float))
+    beyond = np.array([0.4, -0.1, 0.0]) if mode == 1 else np.array([-0.06, -0.08, 0.0])  # d = 0.1
+    d = np.linalg.norm(beyond[:2] - (np.array([0.4, 0.0]) if mode == 1 else 0.0))
+    for depth, inside in ((0.0, False), (1e-17, False), (-1e-17, False), (0.05, False), (-0.05, False),
+                          (0.099, False), (0.101, True), (0.3, True)):
+        x = np.vstack([beyond - [0.0, 0.0, depth], face])
+        N, n = np.zeros(k), np.zeros(3)
+        dist = k3._contact_point(x, k, mode, which, k3.BORDER, N, n)
+        assert dist == pytest.approx((-1.0 if inside else 1.0) * np.hypot(d, depth), rel=1e-12), depth
+    # a one-sided master inside the surface keeps the sign of the face normal's component
+    x = np.vstack([beyond - [0.0, 0.0, 0.05], face])
+    assert k3._contact_point(x, k, mode, which, 0.0, np.zeros(k), np.zeros(3)) < 0.0
+    _check_derivatives(np.vstack([beyond - [0.0, 0.0, 0.3], face]), k, mode, which, 0.0, 0.0, side=k3.BORDER)
+
+
+@pytest.mark.parametrize("k", [3, 4])
 def test_closest_point_and_gap_on_a_flat_face(k):
     """A flat face in the plane z = 0.2 (counter-clockwise from +z): the projection of a slave at
     height z is its foot, the gap z − 0.2 − offset, the normal +z; a point off the face is

@@ -130,6 +130,7 @@ class Interface:
         self.size = float(np.linalg.norm(both.max(axis=0) - both.min(axis=0)))
         self.touch = 1e-6 * self.h  # a gap below this keeps the penalty stiffness (no force)
         self.uzawa_updates = 0
+        self.after_update = False  # whether this step's Newton solve follows an Uzawa update (of any pass)
         # staged construction: the slaves and master segments that exist (None: all), and the
         # initial gaps taken as zero (approach I, :meth:`cancel_initial_gaps`), added to the offsets
         self.slave_on = self.segment_on = None
@@ -741,6 +742,7 @@ class Contact(Contribution):
     def before_step(self) -> None:
         for itf in self.interfaces:
             itf.uzawa_updates = 0
+            itf.after_update = False
 
     def before_solve(self) -> None:
         """A Newton solve starts: its first tangent is the exact one; each interface notes whether
@@ -799,8 +801,10 @@ class Contact(Contribution):
 
     def on_converged(self) -> bool:
         """One Uzawa update on every augmented interface that needs it; True if any changed."""
-        changed = [itf.augment() for itf in self.interfaces]
-        return any(changed)
+        changed = any([itf.augment() for itf in self.interfaces])
+        for itf in self.interfaces:  # the next solve starts from a converged state
+            itf.after_update = itf.after_update or changed
+        return changed
 
     def history(self, report) -> dict:
         return {"uzawa_updates": report.updates}

@@ -17,7 +17,8 @@ evaluates the slaves whose x dof it owns. At each evaluation
    stops Newton from alternating between them. A slave that falls onto no face but lies within
    the margin of an edge or vertex of one — beyond the faces on both sides of a convex edge, or
    beyond an edge of the surface's border — meets that edge or vertex (:mod:`.kernels3d`, modes
-   1 and 2): crossing from face to edge to face the contact point, the normal and the gap are
+   1 and 2; beyond the border a slave counts as inside only below the 45° line from it, so
+   that a slave beside a solid, at its face's level, is not in it): crossing from face to edge to face the contact point, the normal and the gap are
    continuous;
 3. the kernels give the pair's gap, force and tangent (15 dofs: the slave, then four face nodes;
    a triangle's fourth is none).
@@ -134,6 +135,9 @@ class Interface3D(Interface):
         pairs = np.sort(np.stack([faces, np.roll(faces, -1, axis=1)], axis=2), axis=2).reshape(-1, 2)
         _, inverse, count = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
         self.free_edge = (count[inverse] == 1).reshape(len(faces), k)
+        self.border_node = np.zeros(len(self.master.X), dtype=bool)
+        self.border_node[faces[self.free_edge]] = True
+        self.border_node[np.roll(faces, -1, axis=1)[self.free_edge]] = True
         # each pair's master nodes: the face's (flat), or its stencil: the face's nodes, then the
         # other nodes of the faces around them, whose positions set its nodal normals (smooth)
         if self.smooth:
@@ -227,8 +231,15 @@ class Interface3D(Interface):
                         side[slave] = 1.0 if self.two_sided else 0.0
                         if 0.0 < t[i] < 1.0:
                             mode[slave], which[slave] = 1, j
+                            border = self.free_edge[m[rest[i]], j]
                         else:
                             mode[slave], which[slave] = 2, (j if t[i] == 0.0 else (j + 1) % self.nodes[m[rest[i]]])
+                            border = self.border_node[self.faces[m[rest[i]], which[slave]]]
+                        # beyond the border of a solid's surface (whose side faces are not part of
+                        # it) a slave beside the body, even a hair below the face's plane, is not
+                        # in it: the 45° rule of kernels3d
+                        if border and not self.two_sided:
+                            side[slave] = kernels3d.BORDER
         return face, mode, which, side
 
     def _beyond_free_edges(self, m: np.ndarray, xi: np.ndarray, eta: np.ndarray) -> np.ndarray:
@@ -271,13 +282,15 @@ class Interface3D(Interface):
             self.had_contact = bool(self.comm.allreduce(int(np.any(lam - self.penalty * g > 0.0)), op=MPI.MAX))
         # a pair open by less than the touch band keeps the penalty stiffness (no force): it holds
         # bodies that touch without load, and steadies the first corrections of a stiff penalty.
-        # Past TOUCH_EVALUATIONS evaluations of a Newton solve it is kept only while no pair is
-        # closed: the stiffness without a force is not the residual's derivative, and at pairs
-        # with zero pressure and zero gap (overconstrained nodes of a two-pass interface between
-        # non-matching faces) Newton would converge linearly (measured: 0.83 per iteration)
+        # Past TOUCH_EVALUATIONS evaluations of a step's first Newton solve, and in the solves
+        # after an Uzawa update (which start from a converged state), it is kept only while no
+        # pair is closed: the stiffness without a force is not the residual's derivative, and at
+        # pairs with zero pressure and zero gap (overconstrained nodes of a two-pass interface
+        # between non-matching faces, or slaves over the master's vertices) Newton would converge
+        # linearly (measured: 0.83 and 0.74 per iteration)
         self.evaluations += 1
         band = -self.penalty * self.touch
-        if self.evaluations > self.TOUCH_EVALUATIONS and \
+        if (self.evaluations > self.TOUCH_EVALUATIONS or self.after_update) and \
                 self.comm.allreduce(int(np.any(lam - self.penalty * g > 0.0)), op=MPI.MAX):
             band = 0.0
         keep = (lam - self.penalty * g) >= band

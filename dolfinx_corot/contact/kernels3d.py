@@ -16,7 +16,11 @@ the sign making n point out of the master (the side of the face normal at the fa
 A two-sided master (a shell's mid-surface, whose contact faces lie at ±t/2 on either side) is
 met on the slave's ``side`` (±1): on the face n = side × the face normal, at an edge or a vertex
 n = (x_s − x_c)/|x_s − x_c| (the free edge of a shell is met as a rounded edge); ``side`` 0 is
-the one-sided master of a solid.
+the one-sided master of a solid. Beyond the border of a solid's surface (``side`` BORDER) the
+body's side faces are not known: a slave beyond a border edge or vertex counts as inside only
+below the 45° line from it (deeper below the face's plane than it is beyond the border), so that
+a slave beside the body, at or a hair below the face's plane, is outside (grazing), and one that
+sinks below a shared border (two blocks flush, pressed) is still held.
 Gap g = (x_s − x_c)·n − offset (offset: a shell's half thickness, a beam's half depth); pressure
 p = ⟨λ − ε g⟩ (penalty ε; λ the augmented-Lagrangian multiplier, 0 for pure penalty); with the
 slave's tributary area A the pair's energy is W = A ⟨λ − ε g⟩²/(2ε) and its internal force
@@ -152,6 +156,9 @@ def inside(k, xi, eta, tol):
     return abs(xi) <= 1.0 + tol and abs(eta) <= 1.0 + tol
 
 
+BORDER = 2.0  # ``side`` of a pair at an edge or vertex of the border of a one-sided master
+
+
 @numba.njit(cache=True)
 def _contact_point(x, k, mode, which, side, N, n):
     """The contact point's weights N (k,) on the face nodes and the unit normal n (3,) out of the
@@ -205,6 +212,7 @@ def _contact_point(x, k, mode, which, side, N, n):
             N[which] = 1.0
         norm2 = zero
         along = 0.0
+        nc2 = 0.0
         for d in range(3):
             xc = zero
             for a in range(k):
@@ -212,8 +220,12 @@ def _contact_point(x, k, mode, which, side, N, n):
             n[d] = x[0, d] - xc
             norm2 += n[d] * n[d]
             along += (n[d] * nc[d]).real
+            nc2 += (nc[d] * nc[d]).real
         norm = np.sqrt(norm2)
-        sign = 1.0 if (along >= 0.0 or side != 0.0) else -1.0
+        if side == BORDER:  # inside only below the 45° line: deeper than beyond the border
+            sign = -1.0 if (along < 0.0 and along * along > 0.5 * norm2.real * nc2) else 1.0
+        else:
+            sign = 1.0 if (along >= 0.0 or side != 0.0) else -1.0
         for d in range(3):
             n[d] = sign * n[d] / norm
     dist = zero

@@ -103,25 +103,22 @@ def nodal_normals(x, k, star, nstar, nn):
 
 @numba.njit(cache=True)
 def _edge_curvature(x, nn, a, b, c):
-    """Nagata's coefficient c (3,) of the edge from face node a to b: the quadratic
-    x(s) = (1 − s) x_a + s x_b − c s (1 − s) whose tangents at its ends are normal to n_a and n_b,
-    c = (d·Δ/|v|²) v + (d·v/|Δ|²) Δ with d = x_b − x_a, v = (n_a + n_b)/2, Δ = (n_a − n_b)/2
-    (Nagata 2005); the second term's denominator is kept from zero by 1e-12 (parallel normals:
-    a straight edge)."""
-    dv = x[0, 0] * 0.0
-    dd = dv
-    vv = dv
-    DD = dv
+    """The curvature coefficient c (3,) of the edge from face node a to b, whose curve is the
+    quadratic x(s) = (1 − s) x_a + s x_b − c s (1 − s): c = (d·Δ/|v|²) v with d = x_b − x_a,
+    v = (n_a + n_b)/2, Δ = (n_a − n_b)/2, the part along the mean normal of Nagata's coefficient
+    (Nagata 2005: c = (d·Δ/|v|²) v + (d·v/|Δ|²) Δ). Nagata's second, in-plane part makes the end
+    tangents exactly normal to both nodal normals; it vanishes on circular arcs, cylinders and
+    spheres (there the chord is normal to the mean normal) and is singular as the normals turn
+    parallel (1/|Δ|²): on a nearly flat, slightly rough surface it reached 25 times the edge's
+    length, folding the patch and making the point along the normal field jump. It is left out."""
+    dd = x[0, 0] * 0.0
+    vv = dd
     for d in range(3):
-        e = x[1 + b, d] - x[1 + a, d]
         v = 0.5 * (nn[a, d] + nn[b, d])
-        D = 0.5 * (nn[a, d] - nn[b, d])
-        dv += e * v
-        dd += e * D
+        dd += (x[1 + b, d] - x[1 + a, d]) * 0.5 * (nn[a, d] - nn[b, d])
         vv += v * v
-        DD += D * D
     for d in range(3):
-        c[d] = dd / vv * 0.5 * (nn[a, d] + nn[b, d]) + dv / (DD + 1e-12) * 0.5 * (nn[a, d] - nn[b, d])
+        c[d] = dd / vv * 0.5 * (nn[a, d] + nn[b, d])
 
 
 @numba.njit(cache=True)

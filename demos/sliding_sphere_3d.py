@@ -182,7 +182,8 @@ def main() -> dict:
         demo.say(f"{'smoothed' if smooth else 'flat    '} master: {out['dofs']} block dofs; steady sliding: Fz "
                  f"{out['mean_Fz']:.3f}, off its trend by at most {100 * out['Fz_spike']:.2f} %; Fx off its trend by "
                  f"at most {100 * out['Fx_spike']:.2f} % of Fz (mean {100 * out['Fx_mean']:+.2f} %); "
-                 f"{out['newton_iterations']} Newton its (at most {out['max_iterations']} a step), {out['cuts']} cuts, {out['wall_s']:.1f} s")
+                 f"{out['newton_iterations']} Newton its (at most {out['max_iterations']} a step), {out['cuts']} cuts, "
+                 f"{out['wall_s']:.1f} s")
     flat, smooth = rows
     keys = [k for k in rows[0] if k not in ("travel", "Fz", "Fx", "iterations")]
     demo.table("sliding_sphere_3d.csv", [{k: r[k] for k in keys} for r in rows])

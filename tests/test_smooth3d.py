@@ -110,7 +110,8 @@ def test_a_nearly_flat_rough_master_keeps_a_smooth_force(quad, seed):
         xp, xm = x.copy(), x.copy()
         xp.flat[j] += 1e-7
         xm.flat[j] -= 1e-7
-        fd[:, j] = (_evaluate(xp, k, rows, star, nstar, lam=0.5)[1] - _evaluate(xm, k, rows, star, nstar, lam=0.5)[1]) / 2e-7
+        fd[:, j] = (_evaluate(xp, k, rows, star, nstar, lam=0.5)[1] -
+                    _evaluate(xm, k, rows, star, nstar, lam=0.5)[1]) / 2e-7
     assert np.abs(K[:, :m] - fd).max() < 1e-7 * np.abs(K).max()
 
 

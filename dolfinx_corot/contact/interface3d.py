@@ -18,8 +18,8 @@ evaluates the slaves whose x dof it owns. At each evaluation
    the margin of an edge or vertex of one — beyond the faces on both sides of a convex edge, or
    beyond an edge of the surface's border — meets that edge or vertex (:mod:`.kernels3d`, modes
    1 and 2; beyond the border a slave counts as inside only below the 45° line from it, so
-   that a slave beside a solid, at its face's level, is not in it): crossing from face to edge to face the contact point, the normal and the gap are
-   continuous;
+   that a slave beside a solid, at its face's level, is not in it): crossing from face to edge
+   to face the contact point, the normal and the gap are continuous;
 3. the kernels give the pair's gap, force and tangent (15 dofs: the slave, then four face nodes;
    a triangle's fourth is none).
 

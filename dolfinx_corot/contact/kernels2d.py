@@ -1,4 +1,5 @@
-r"""Frictionless node-to-segment contact in 2D: gap, force and consistent tangent.
+r"""Node-to-segment contact in 2D: gap, force and consistent tangent, frictionless and with
+Coulomb friction (:func:`node_to_smooth_segment_friction`).
 
 A slave node :math:`\mathbf x_s` meets the straight master segment
 :math:`\mathbf x_1\mathbf x_2` (the master body on the left of
@@ -211,8 +212,9 @@ def node_to_vertex(xs, xv, normal, offset, multiplier, penalty, area, with_tange
 # -- smooth (C¹) master surface ---------------------------------------------------------------
 @numba.njit(cache=True, error_model="numpy")
 def _hermite(x, xi):
-    """Point, first and second derivatives of the Hermite curve of the segment a → b at ξ, and the
-    weights φ of (p, a, b, q); x = (x_s, x_p, x_a, x_b, x_q) flattened (10,).
+    """Point, first and second derivatives of the Hermite curve of the segment a → b at ξ, the
+    weights φ of (p, a, b, q) and their derivatives dφ/dξ; x = (x_s, x_p, x_a, x_b, x_q)
+    flattened (10,).
 
     Nodal tangents: Catmull–Rom, (x_b − x_p)/2 at a and (x_q − x_a)/2 at b; at an end without a
     neighbour (p = a or q = b: a free end or a sharp corner) the natural end condition x'' = 0,
@@ -249,7 +251,7 @@ def _hermite(x, xi):
     ty = dw[0] * x[3] + dw[1] * x[5] + dw[2] * x[7] + dw[3] * x[9]
     cx = sw[0] * x[2] + sw[1] * x[4] + sw[2] * x[6] + sw[3] * x[8]
     cy = sw[0] * x[3] + sw[1] * x[5] + sw[2] * x[7] + sw[3] * x[9]
-    return px, py, tx, ty, cx, cy, w
+    return px, py, tx, ty, cx, cy, w, dw
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -260,7 +262,7 @@ def _closest_on_curve(x, xi, iterations):
         return xi, False
     last = False
     for _ in range(iterations):
-        px, py, tx, ty, cx, cy, w = _hermite(x, xi)
+        px, py, tx, ty, cx, cy, w, _ = _hermite(x, xi)
         rx = x[0] - px
         ry = x[1] - py
         f = rx * tx + ry * ty
@@ -284,7 +286,7 @@ def _smooth_gap_gradient(x, out, xi):
     complex, from the projection coordinate ξ solved to round-off (the real part); returns (g, ξ)
     and N = ∂g/∂x in ``out``: (n, −φ_p n, −φ_a n, −φ_b n, −φ_q n) — at the closest point the
     variations of ξ and of the normal drop out (r ∥ n ⊥ x')."""
-    px, py, tx, ty, cx, cy, w = _hermite(x, xi)
+    px, py, tx, ty, cx, cy, w, _ = _hermite(x, xi)
     lt = np.sqrt(tx * tx + ty * ty)
     nx = ty / lt
     ny = -tx / lt
@@ -381,3 +383,149 @@ def node_to_smooth_segment(x, side, offset, multiplier, penalty, area, with_tang
                 K[i, r, c] -= a * pi * side[i] * Nc[r].imag / _H
         _symmetrize(K[i])
     return g, xi, p, f, K, energy, normal
+
+
+# -- Coulomb friction on the C¹ master curve ---------------------------------------------------
+@numba.njit(cache=True, error_model="numpy")
+def slip(x, xi, xi0, out):
+    r"""Elastic slip s = (x_s − X₀)·τ(ξ) of the slave x[0:2] from the stick point X₀ of parameter
+    ξ₀ on the segment's curve, the slave's closest point being at ξ, and its gradient ∂s/∂x (10,)
+    into ``out``; real or complex x (ξ then the complex solution). In closed form, with
+    a = x'(ξ), c₂ = x''(ξ), r = x_s − x(ξ) (normal to a), ν the unit normal, r₀ = x_s − X₀:
+    δξ = [(δx_s − Σ φ_k δx_k)·a + r·Σ φ'_k δx_k] / (a·a − r·c₂) (the closest point's variation) and
+    δs = (δx_s − Σ φ_k(ξ₀) δx_k)·τ + (r₀·ν/|a|) ν·(Σ φ'_k δx_k + c₂ δξ)."""
+    px, py, tx, ty, cx, cy, w, dw = _hermite(x, xi)
+    w0 = _hermite(x, xi0 + 0.0 * xi)[6]
+    X0x = w0[0] * x[2] + w0[1] * x[4] + w0[2] * x[6] + w0[3] * x[8]
+    X0y = w0[0] * x[3] + w0[1] * x[5] + w0[2] * x[7] + w0[3] * x[9]
+    la = np.sqrt(tx * tx + ty * ty)
+    taux = tx / la
+    tauy = ty / la
+    nux = tauy
+    nuy = -taux
+    r0x = x[0] - X0x
+    r0y = x[1] - X0y
+    rx = x[0] - px
+    ry = x[1] - py
+    den = tx * tx + ty * ty - (rx * cx + ry * cy)
+    q = (r0x * nux + r0y * nuy) / la
+    nc = nux * cx + nuy * cy
+    out[0] = taux + q * nc * tx / den
+    out[1] = tauy + q * nc * ty / den
+    for k in range(4):
+        cxk = (-w[k] * tx + dw[k] * rx) / den  # ∂ξ/∂x_k
+        cyk = (-w[k] * ty + dw[k] * ry) / den
+        out[2 + 2 * k] = -w0[k] * taux + q * (dw[k] * nux + nc * cxk)
+        out[3 + 2 * k] = -w0[k] * tauy + q * (dw[k] * nuy + nc * cyk)
+    return r0x * taux + r0y * tauy
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _friction_force(x, xi, side, offset, lam, eps, area, eps_t, mu, cohesion, xi0, f):
+    """Gap, pressure, traction, slip and force f (10,) of one pair at the closest point ξ (the
+    module's law); returns (g, p, t, s, slipping)."""
+    N = np.empty(10, dtype=x.dtype)
+    S = np.empty(10, dtype=x.dtype)
+    g = side * _smooth_gap_gradient(x, N, xi) - offset
+    p = lam - eps * g
+    if p.real <= 0.0:
+        for r in range(10):
+            f[r] = 0.0
+        return g, 0.0 * p, 0.0 * p, 0.0 * p, False
+    s = slip(x, xi, xi0, S)
+    t = eps_t * s
+    cap = cohesion + mu * p
+    slipping = abs(t.real) > cap.real
+    if slipping:
+        t = cap if t.real > 0.0 else -cap
+    for r in range(10):
+        f[r] = -area * p * side * N[r] + area * t * S[r]
+    return g, p, t, s, slipping
+
+
+@numba.njit(cache=True, error_model="numpy")
+def node_to_smooth_segment_friction(x, side, offset, multiplier, penalty, area, eps_t, mu, cohesion, xi0,
+                                    with_tangent):
+    r"""Frictional contact of k slaves on the segments of the C¹ master curve: Coulomb's law with
+    cohesion.
+
+    Normally as :func:`node_to_smooth_segment` (closest point x(ξ), gap g, p = ⟨λ − εg⟩).
+    Tangentially the slave is attached to a point of the master, its stick point
+    X₀ = Σ φ_k(ξ₀) x_k: the master's material point of parameter ξ₀, which moves with the master's
+    nodes. The elastic slip is the distance from X₀ to the slave along the unit tangent
+    τ = x'/|x'| at the contact point, s = (x_s − X₀)·τ(ξ) (:func:`slip`): a function of relative
+    positions only, so rigid motions of the pair change neither s nor the traction (frame
+    indifference). The tangential traction (force per tributary length A) is the elastic
+    predictor ε_T s returned onto Coulomb's slip surface |t| ≤ c + μ p (c the cohesion,
+    μ = tan φ): t = ε_T s in stick (|ε_T s| ≤ c + μ p), t = (c + μ p) sign(s) in slip. The pair's
+    internal force is f = −A p ∂g/∂x + A t ∂s/∂x: in stick the gradient of the energy
+    A⟨λ − εg⟩²/2ε + A ε_T s²/2 (a symmetric tangent); in slip the traction follows the pressure
+    and the tangent is not symmetric. Both parts are gradients of rotation-invariant scalars
+    weighted by scalars, so the pair conserves linear and angular momentum. The return map moves
+    the stick point at convergence (:func:`slipped_stick_point`). K = ∂f/∂x is the complex-step
+    derivative of f, the projection re-solved in complex arithmetic, stick or slip decided on
+    the real parts. (Wriggers, Computational Contact Mechanics, 2nd ed., Springer 2006:
+    tangential slip in the master's convected coordinates and Coulomb's law by a return map;
+    Laursen, Computational Contact and Impact Mechanics, Springer 2002: frame-indifferent
+    tangential kinematics.)
+
+    x: (k, 10) current positions (x_s, x_p, x_a, x_b, x_q); side, offset, multiplier λ, penalty ε,
+    area A, tangential penalty ε_T, friction coefficient μ, cohesion c and stick points ξ₀ (on each
+    pair's segment curve): (k,). Returns g, ξ, p, t, s: (k,) (g inf where no closest point was
+    found; p, t zero for open pairs), slipping (k,) bool, f (k, 10), K (k, 10, 10)."""
+    k = x.shape[0]
+    g = np.empty(k)
+    xi = np.empty(k)
+    p = np.zeros(k)
+    t = np.zeros(k)
+    s = np.zeros(k)
+    slipping = np.zeros(k, dtype=np.bool_)
+    f = np.zeros((k, 10))
+    K = np.zeros((k, 10, 10))
+    xc = np.empty(10, dtype=np.complex128)
+    fc = np.empty(10, dtype=np.complex128)
+    for i in range(k):
+        xii, ok = _closest_on_curve(x[i], _straight_xi(x[i]), 30)
+        xi[i] = xii
+        if not ok:
+            g[i] = np.inf
+            continue
+        g[i], p[i], t[i], s[i], slipping[i] = _friction_force(x[i], xii, side[i], offset[i], multiplier[i],
+                                                              penalty[i], area[i], eps_t[i], mu[i], cohesion[i],
+                                                              xi0[i], f[i])
+        if not with_tangent or p[i] <= 0.0:
+            continue
+        for c in range(10):
+            for j in range(10):
+                xc[j] = x[i, j]
+            xc[c] += 1j * _H
+            xic, _ = _closest_on_curve(xc, xii + 0j, 3)
+            _friction_force(xc, xic, side[i], offset[i], multiplier[i] + 0j, penalty[i], area[i], eps_t[i],
+                            mu[i], cohesion[i], xi0[i], fc)
+            for r in range(10):
+                K[i, r, c] = fc[r].imag / _H
+    return g, xi, p, t, s, slipping, f, K
+
+
+@numba.njit(cache=True, error_model="numpy")
+def slipped_stick_point(x, xi, xi0, t, eps_t):
+    """The return map's new stick point after a slip: the parameter ξ₁ of the point of the
+    segment's curve at the elastic distance t/ε_T behind the slave along the curve (s = t/ε_T
+    from it), by Newton on s(ξ₁) from ξ₀; x (10,) the converged positions, ξ the slave's closest
+    point. Returns ξ₁ (unchanged if t is ε_T s: a sticking slave keeps its point)."""
+    S = np.empty(10)
+    target = t / eps_t
+    xi1 = xi0
+    for _ in range(30):
+        s = slip(x, xi, xi1, S)
+        px, py, tx, ty, cx, cy, w, dw = _hermite(x, xi1)
+        la = np.sqrt(tx * tx + ty * ty)
+        # ∂s/∂ξ₁ = −x'(ξ₁)·τ(ξ): about −|x'|
+        _, _, ax, ay, _, _, _, _ = _hermite(x, xi)
+        lt = np.sqrt(ax * ax + ay * ay)
+        ds = -(tx * ax + ty * ay) / lt
+        step = (s - target) / ds
+        xi1 = xi1 - step
+        if abs(step) * la < 1e-14 * (1.0 + abs(target)):
+            break
+    return xi1

@@ -1,0 +1,148 @@
+"""Coulomb friction of 2D node-to-segment contact on the C¹ master curve (issue 16, the kernel).
+References: the slip's gradient and the tangent against central differences; in stick the force
+is the gradient of the energy A⟨λ − εg⟩²/2ε + A ε_T s²/2; in slip the tangential traction is
+c + μ p (Coulomb with cohesion) against the slip; frame indifference and momentum (invariance of
+the gap and the slip under rigid motions)."""
+import numpy as np
+import pytest
+
+from dolfinx_corot.contact.kernels2d import (node_to_smooth_segment, node_to_smooth_segment_friction, slip,
+                                             slipped_stick_point)
+
+EPS, EPS_T, AREA = 100.0, 60.0, 0.7
+
+
+def _stencil(seed: int = 0, R: float = 3.0):
+    """(p, a, b, q) on a circle of radius R (centre below: the body inside), shaken by 1 %, and
+    the flattened pair coordinates for a slave 0.02 inside the curve above ξ ≈ 0.4."""
+    rng = np.random.default_rng(seed)
+    angles = np.radians([110.0, 100.0, 90.0, 80.0])  # counter-clockwise order reversed: body on the left
+    nodes = np.column_stack([R * np.cos(angles), R * np.sin(angles) - R]) + rng.normal(0.0, 0.005, (4, 2))
+    a, b = nodes[1], nodes[2]
+    mid = a + 0.4 * (b - a)
+    n = np.array([(b - a)[1], -(b - a)[0]]) / np.linalg.norm(b - a)
+    return np.concatenate([mid - 0.02 * n, nodes.ravel()])
+
+
+def _evaluate(x, xi0, lam=0.0, mu=0.3, cohesion=0.0, side=1.0, tangent=False):
+    one = np.ones(1)
+    return node_to_smooth_segment_friction(x[None], side * one, 0.0 * one, lam * one, EPS * one, AREA * one,
+                                           EPS_T * one, mu * one, cohesion * one, xi0 * one, tangent)
+
+
+def _fd(fun, x, h=1e-7):
+    cols = []
+    for j in range(len(x)):
+        xp, xm = x.copy(), x.copy()
+        xp[j] += h
+        xm[j] -= h
+        cols.append((np.asarray(fun(xp)) - np.asarray(fun(xm))) / (2 * h))
+    return np.array(cols).T
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("dxi0", [0.0, 0.03, -0.2])
+def test_the_slip_gradient_is_the_derivative_of_the_slip(seed, dxi0):
+    """∂s/∂x in closed form (the closest point's variation included) against central differences of
+    s, the closest point re-solved: 1e-8; the stick point moves with the master's nodes."""
+    x = _stencil(seed)
+    xi = _evaluate(x, 0.0)[1][0]
+
+    def s_of(y):
+        xi_y = _evaluate(y, 0.0)[1][0]
+        return slip(y, xi_y, xi + dxi0, np.zeros(10))
+
+    grad = np.zeros(10)
+    slip(x, xi, xi + dxi0, grad)
+    assert np.abs(grad - _fd(s_of, x)).max() < 1e-8 * np.abs(grad).max()
+
+
+@pytest.mark.parametrize("seed", range(3))
+@pytest.mark.parametrize("lam", [0.0, 2.0])
+def test_in_stick_the_force_is_the_energy_gradient_and_the_tangent_its_symmetric_derivative(seed, lam):
+    """A slave 0.004 (in ξ) from its stick point, μ large enough to stick: f = ∂W/∂x with
+    W = A⟨λ − εg⟩²/2ε + A ε_T s²/2 (1e-8), K = ∂f/∂x (1e-7 of its largest entry) and symmetric."""
+    x = _stencil(seed)
+    xi = _evaluate(x, 0.0)[1][0]
+    xi0 = xi - 0.004
+
+    def energy(y):
+        g, _, p, t, s, _, _, _ = _evaluate(y, xi0, lam, mu=5.0)
+        return AREA * p[0] ** 2 / (2 * EPS) + AREA * EPS_T * s[0] ** 2 / 2
+
+    g, _, p, t, s, slipping, f, K = _evaluate(x, xi0, lam, mu=5.0, tangent=True)
+    assert p[0] > 0.0 and not slipping[0] and t[0] == pytest.approx(EPS_T * s[0], rel=1e-14)
+    assert np.abs(f[0] - _fd(energy, x)).max() < 1e-8 * np.abs(f[0]).max()
+    Kfd = _fd(lambda y: _evaluate(y, xi0, lam, mu=5.0)[6][0], x)
+    assert np.abs(K[0] - Kfd).max() < 1e-7 * np.abs(K[0]).max()
+    assert np.abs(K[0] - K[0].T).max() < 1e-10 * np.abs(K[0]).max()
+
+
+@pytest.mark.parametrize("seed", range(3))
+@pytest.mark.parametrize("cohesion", [0.0, 0.05])
+@pytest.mark.parametrize("direction", [1.0, -1.0])
+def test_in_slip_the_traction_is_coulombs_and_the_tangent_its_unsymmetric_derivative(seed, cohesion, direction):
+    """A slave 0.05 (in ξ) from its stick point, μ = 0.3: it slips, the traction is c + μ p against
+    the slip (1e-14), K = ∂f/∂x (1e-7) and not symmetric (the traction follows the pressure)."""
+    x = _stencil(seed)
+    xi = _evaluate(x, 0.0)[1][0]
+    xi0 = xi - direction * 0.05
+    g, _, p, t, s, slipping, f, K = _evaluate(x, xi0, 1.0, 0.3, cohesion, tangent=True)
+    assert slipping[0] and np.sign(s[0]) == direction
+    assert t[0] == pytest.approx(direction * (cohesion + 0.3 * p[0]), rel=1e-14)
+    Kfd = _fd(lambda y: _evaluate(y, xi0, 1.0, 0.3, cohesion)[6][0], x)
+    assert np.abs(K[0] - Kfd).max() < 1e-7 * np.abs(K[0]).max()
+    assert np.abs(K[0] - K[0].T).max() > 1e-3 * np.abs(K[0]).max()
+
+
+def test_without_slip_or_friction_the_kernel_is_the_frictionless_one():
+    """At its stick point (s = 0) a sticking slave carries no tangential force: the force is the
+    frictionless kernel's (1e-13) and the tangent adds the stick stiffness A ε_T ∂s/∂x ∂s/∂xᵀ
+    (1e-11); with μ = c = 0 a slipping slave has the frictionless force and tangent."""
+    x = _stencil(1)
+    one = np.ones(1)
+    _, xi, _, f0, K0 = node_to_smooth_segment(x[None], one, 0.0 * one, 0.5 * one, EPS * one, AREA * one, True)[:5]
+    S = np.zeros(10)
+    slip(x, xi[0], xi[0], S)
+    for xi0, mu, stick in ((xi[0], 0.3, AREA * EPS_T * np.outer(S, S)), (xi[0] - 0.1, 0.0, 0.0)):
+        _, _, _, t, _, _, f, K = _evaluate(x, xi0, 0.5, mu, tangent=True)
+        assert abs(t[0]) < 1e-13
+        assert np.abs(f - f0).max() < 1e-13 * np.abs(f0).max()
+        assert np.abs(K[0] - K0[0] - stick).max() < 1e-11 * np.abs(K0).max()
+
+
+@pytest.mark.parametrize("slipping", [False, True])
+def test_frame_indifference_and_momentum(slipping):
+    """The pair turned by 2.3 rad and moved by 8: gap, slip, pressure and traction unchanged (1e-10:
+    the coordinates, 7, against the gap, 0.02, cost three digits), the forces turned with it (1e-12);
+    the forces sum to zero and their moment vanishes (1e-13)."""
+    x = _stencil(2)
+    xi = _evaluate(x, 0.0)[1][0]
+    xi0 = xi - (0.05 if slipping else 0.002)
+    out = _evaluate(x, xi0, 0.5, 0.3)
+    c, sn = np.cos(2.3), np.sin(2.3)
+    Q = np.array([[c, -sn], [sn, c]])
+    y = (x.reshape(5, 2) @ Q.T + [4.0, -7.0]).ravel()
+    moved = _evaluate(y, xi0, 0.5, 0.3)
+    assert out[5][0] == slipping and moved[5][0] == slipping
+    for j in (0, 2, 3, 4):  # g, p, t, s
+        assert moved[j][0] == pytest.approx(out[j][0], rel=1e-10, abs=1e-14)  # coordinates of 7 against gaps of 0.02
+    f = out[6][0].reshape(5, 2)
+    assert np.abs(moved[6][0].reshape(5, 2) - f @ Q.T).max() < 1e-12 * np.abs(f).max()
+    assert np.abs(f.sum(axis=0)).max() < 1e-13 * np.abs(f).max()
+    X = x.reshape(5, 2)
+    assert abs(np.sum(X[:, 0] * f[:, 1] - X[:, 1] * f[:, 0])) < 1e-13 * np.abs(f).max() * 10
+
+
+def test_the_return_map_puts_the_stick_point_at_the_elastic_distance():
+    """After a slip the new stick point lies where the slave's slip from it is t/ε_T (1e-13):
+    evaluated from it, the slave carries the traction it slipped with (1e-12)."""
+    x = _stencil(3)
+    xi = _evaluate(x, 0.0)[1][0]
+    xi0 = xi - 0.05
+    _, _, p, t, s, slipping, _, _ = _evaluate(x, xi0, 1.0, 0.3)
+    assert slipping[0]
+    xi1 = slipped_stick_point(x, xi, xi0, t[0], EPS_T)
+    assert slip(x, xi, xi1, np.zeros(10)) == pytest.approx(t[0] / EPS_T, rel=1e-13)
+    t1 = _evaluate(x, xi1, 1.0, 0.3)[3]  # on the slip surface: stick or slip, the same traction
+    assert t1[0] == pytest.approx(t[0], rel=1e-12)

@@ -13,7 +13,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
 
 from . import rotations  # noqa: E402
 from .amplitudes import Amplitude
-from .contact.laws import AugmentedLagrangian, ContactError, Penalty
+from .contact.laws import AugmentedLagrangian, ContactError, Coulomb, Penalty
 from .contact.pair import ContactPair
 from .io.mesh import GroupNotFoundError, TaggedMesh, from_gmsh
 from .materials import Elastic, NeoHookean, SaintVenantKirchhoff
@@ -26,7 +26,8 @@ from .solvers import (ArcLength, CheckpointError, ConvergenceError, CriticalPoin
 
 __version__ = "0.1.0"
 
-__all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "ContactPair", "Penalty", "Circle", "ConvergenceError", "CriticalPoint",
-           "CriticalPointError", "SingularModelError", "Elastic", "GroupNotFoundError", "History", "LoadControl",
-           "MeshError", "NeoHookean", "NewtonOptions", "Pipe", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh", "from_gmsh",
-           "rotations", "solve"]
+__all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "ContactPair",
+           "Coulomb", "Penalty", "Circle", "ConvergenceError", "CriticalPoint", "CriticalPointError",
+           "SingularModelError", "Elastic", "GroupNotFoundError", "History", "LoadControl", "MeshError", "NeoHookean",
+           "NewtonOptions", "Pipe", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh",
+           "from_gmsh", "rotations", "solve"]

@@ -307,8 +307,9 @@ class Scene:
         return condition
 
     def contact(self, slaves: tuple[PartRef, str], masters: tuple[PartRef, str], law=None,
-                symmetric: bool = False, smooth: bool | None = None, discretization: str = "node_to_face") -> list:
-        """Frictionless node-to-segment (2D) or node-to-face (3D) contact of the nodes of group
+                symmetric: bool = False, smooth: bool | None = None, discretization: str = "node_to_face",
+                friction=None) -> list:
+        """Node-to-segment (2D) or node-to-face (3D) contact of the nodes of group
         ``slaves[1]`` of part ``slaves[0]`` against the segments or faces of ``masters``;
         ``symmetric`` adds the other direction (two-pass contact, for two deformable bodies).
         In 3D the surfaces are boundary face groups of linear solids (tetrahedra, hexahedra),
@@ -332,6 +333,15 @@ class Scene:
         pressure integrated over the overlaps of slave and master faces, the nodal constraints
         weighted gaps; passes the patch test on non-matching faces, :mod:`~dolfinx_corot.contact.mortar`).
 
+        friction (2D node-to-segment): None (default, frictionless) or dc.Coulomb(mu=...) /
+        dc.Coulomb(friction_angle=..., cohesion=...): the shear traction bounded by c + μ p; each
+        slave sticks to a material point of the master (through a tangential penalty) until the
+        bound is reached, then slips; the stick points are history state (committed with each
+        step, restored with a cut step or a restart;
+        :func:`~dolfinx_corot.contact.kernels2d.node_to_smooth_segment_friction`). At a sharp
+        convex vertex of the master the pair is frictionless. The tangent is then not symmetric
+        (LU while the interface is engaged).
+
         Returns a :class:`~dolfinx_corot.contact.ContactPair`, the sequence of the interfaces made
         (one, or two when symmetric), which gives the interface pressure of both passes combined
         on either side's contact face (``pair.pressure(on="slaves")``, a beam's face at half its
@@ -346,9 +356,13 @@ class Scene:
                                "straight segments passes the patch test: smooth=False)")
         else:
             kind, smooth = Interface, smooth is None or bool(smooth)
-        made = [kind(slaves, masters, law, smooth)]
+        if friction is not None and kind is not Interface:
+            raise ContactError(f"contact '{slaves[1]} -> {masters[1]}': friction in 3D is not implemented yet "
+                               "(2D node-to-segment contact only)")
+        extra = {} if friction is None else {"friction": friction}
+        made = [kind(slaves, masters, law, smooth, **extra)]
         if symmetric:
-            made.append(kind(masters, slaves, law, smooth))
+            made.append(kind(masters, slaves, law, smooth, **extra))
         self.interfaces += made
         return ContactPair(made)
 

@@ -34,8 +34,9 @@ import numpy as np
 from mpi4py import MPI
 
 from ..assembly.contribution import Contribution
-from .kernels2d import node_to_smooth_segment, node_to_vertex, smooth_gap
-from .laws import ContactError, Penalty
+from .kernels2d import (curve_points, node_to_smooth_segment, node_to_smooth_segment_friction, node_to_vertex,
+                        slipped_stick_point, smooth_gap)
+from .laws import ContactError, Coulomb, Penalty
 from .search import broad_phase, narrow_phase
 
 logger = logging.getLogger(__name__)
@@ -89,9 +90,12 @@ class Interface:
     BAND_USES = 3  # corrections per Newton solve that may count lifted pairs as closed
     SYMMETRIC_TANGENT = True
 
-    def __init__(self, slaves, masters, law: Penalty, smooth: bool = True):
+    def __init__(self, slaves, masters, law: Penalty, smooth: bool = True, friction: Coulomb | None = None):
         if not isinstance(law, Penalty):
             raise TypeError(f"contact law must be dc.Penalty or dc.AugmentedLagrangian, got {type(law).__name__}")
+        if friction is not None and not isinstance(friction, Coulomb):
+            raise TypeError(f"contact friction must be dc.Coulomb(...) or None, got {type(friction).__name__}")
+        self.friction = friction
         if slaves[0].model is masters[0].model and slaves[1] == masters[1]:
             raise ContactError(f"contact of surface '{slaves[1]}' with itself is not supported: give two "
                                "surfaces (self-contact is not implemented)")
@@ -137,6 +141,19 @@ class Interface:
         self.exists = True  # (a stage may add or remove the interface)
         self.initial_gap = np.zeros(len(self.area))
         self.gap_cancelled = np.zeros(len(self.area), dtype=bool)
+        # friction: each slave's stick point, the master segment and the parameter on its curve of
+        # the material point it is attached to (−1: none, the slave is not in contact); the last
+        # converged state, the same on every rank
+        self.stick_segment = np.full(len(self.area), -1)
+        self.stick_xi = np.zeros(len(self.area))
+        # within a step: the stick points the step's evaluations use (a slave that touches, or
+        # passes to another segment, gets its point at the first evaluation that needs it and keeps
+        # it until the step converges, so that the step's tangent is the derivative of its forces)
+        self.trial_segment = self.stick_segment.copy()
+        self.trial_xi = self.stick_xi.copy()
+        self._friction_trial = None
+        if friction is not None:
+            self.tangential_penalty = friction.tangential_factor * self.penalty
 
     @property
     def master_surface(self) -> str:
@@ -145,8 +162,9 @@ class Interface:
 
     @property
     def symmetric_tangent(self) -> bool:
-        """Whether the pairs' tangents are symmetric (the Hessians of their energies)."""
-        return self.SYMMETRIC_TANGENT
+        """Whether the pairs' tangents are symmetric (the Hessians of their energies; a slipping
+        slave's traction follows its pressure: not with friction)."""
+        return self.SYMMETRIC_TANGENT and self.friction is None
 
     @staticmethod
     def _tributary(X: np.ndarray, facets: np.ndarray) -> np.ndarray:
@@ -183,11 +201,62 @@ class Interface:
         self._update_existence()
 
     def kept_state(self):
-        """What a cut step restores besides the multipliers (none in 2D)."""
-        return None
+        """What a cut step restores besides the multipliers: the stick points (friction)."""
+        return (self.stick_segment.copy(), self.stick_xi.copy()) if self.friction is not None else None
 
     def restore_kept(self, state) -> None:
-        pass
+        if state is not None:
+            self.stick_segment[:], self.stick_xi[:] = state
+            self.begin_step()
+
+    def begin_step(self) -> None:
+        """A step (or its retry after a cut) starts from the converged stick points."""
+        self.trial_segment = self.stick_segment.copy()
+        self.trial_xi = self.stick_xi.copy()
+
+    def commit(self) -> None:
+        """The step converged: each slave in contact keeps its stick point (sticking) or takes the
+        return map's (slipping: the point at the elastic distance t/ε_T behind it); a slave out of
+        contact has none."""
+        if self.friction is None:
+            return
+        seg = np.full(len(self.area), -1)
+        xi0 = np.zeros(len(self.area))
+        if self._friction_trial is not None:
+            s, m, x, xi, start, t, slipping, p = self._friction_trial
+            for k in np.flatnonzero(p > 0.0):
+                seg[s[k]] = m[k]
+                xi0[s[k]] = (slipped_stick_point(x[k], xi[k], start[k], t[k], self.tangential_penalty) if slipping[k]
+                             else start[k])
+        self.stick_segment = self.comm.allreduce(seg, op=MPI.MAX)
+        self.stick_xi = self.comm.allreduce(xi0, op=MPI.SUM)
+        self.begin_step()
+
+    def _stick_parameters(self, x: np.ndarray, s: np.ndarray, m: np.ndarray, xm: np.ndarray) -> np.ndarray:
+        """The parameters ξ₀ (n,) of the slaves' stick points on the curves of their segments m
+        (pairs x (n, 10); master positions xm): the committed one on the same segment; a slave that comes into contact
+        is attached where it touches (no slip yet); one that has passed to another segment takes
+        the closest point of that segment's curve to its stick point (a constant of the step's
+        tangent: its dependence on the old segment's nodes is left out)."""
+        xi0 = self.trial_xi[s].copy()
+        old = self.trial_segment[s]
+        _, now, _ = smooth_gap(x)
+        new = old < 0
+        xi0[new] = now[new]
+        moved = np.flatnonzero(~new & (old != m))
+        if len(moved):
+            ext = self.ext[old[moved]]
+            y = np.hstack([np.zeros((len(moved), 2))] + [xm[ext[:, j]] for j in range(4)])
+            y[:, :2] = x[moved, :2]
+            point = curve_points(y, self.trial_xi[s[moved]])
+            z = x[moved].copy()
+            z[:, :2] = point
+            _, xi_t, ok = smooth_gap(z)
+            xi0[moved] = np.where(ok, xi_t, now[moved])
+        changed = new | (old != m)
+        self.trial_segment[s[changed]] = m[changed]
+        self.trial_xi[s[changed]] = xi0[changed]
+        return xi0
 
     @property
     def slave_offset(self) -> np.ndarray:
@@ -430,6 +499,7 @@ class Interface:
         f[:] = 0.0
         K[:] = 0.0
         normal[:] = 0.0
+        self._friction_trial = None
         on = mode[s] == 0
         if on.any():
             i = np.flatnonzero(on)
@@ -437,6 +507,18 @@ class Interface:
             offset = self.slave_offset[s[i]] + self.master_offset[m[i]]
             g[i], _, _, f[i], K[i], _, normal[i] = node_to_smooth_segment(x, sides[s[i]], offset, lam[i], eps[i],
                                                                           self.area[s[i]], True, touch)
+            if self.friction is not None:  # the pairs with a pressure: Coulomb's law on the same curve
+                law = self.friction
+                closed = np.flatnonzero(lam[i] - eps[i] * g[i] > 0.0)
+                j = i[closed]
+                xj = x[closed]
+                start = self._stick_parameters(xj, s[j], m[j], xm)
+                one = np.ones(len(j))
+                gj, xij, pj, tj, _, slipping, fj, Kj = node_to_smooth_segment_friction(
+                    xj, sides[s[j]], offset[closed], lam[j], eps[j], self.area[s[j]], self.tangential_penalty * one,
+                    law.coefficient * one, law.cohesion * one, start, True)
+                f[j], K[j] = fj, Kj
+                self._friction_trial = (s[j], m[j], xj, xij, start, tj, slipping, pj)
         if (~on).any():
             normals = self._vertex_normals(xm)
             for k in (1, 2):
@@ -512,7 +594,8 @@ class Interface:
         """What defines the interface (for the scene's fingerprint and ``Scene.effects``)."""
         return {"slaves": self.slave_spec[1], "masters": self.master_spec[1], "law": repr(self.law),
                 "smooth": self.smooth, "penalty": self.penalty, "slave_nodes": len(self.area),
-                "master_segments": len(self.master.facets)}
+                "master_segments": len(self.master.facets),
+                **({"friction": repr(self.friction)} if self.friction is not None else {})}
 
     def correction_ratio(self, ds: np.ndarray, dm: np.ndarray) -> float:
         """How far a Newton correction (ds (n_slaves, 2), dm (n_master, 2) of all nodes) moves this
@@ -743,6 +826,7 @@ class Contact(Contribution):
         for itf in self.interfaces:
             itf.uzawa_updates = 0
             itf.after_update = False
+            itf.begin_step()
 
     def before_solve(self) -> None:
         """A Newton solve starts: its first tangent is the exact one; each interface notes whether
@@ -799,6 +883,11 @@ class Contact(Contribution):
         worst = self.comm.allreduce(worst, op=MPI.MAX)
         return 1.0 if worst <= 1.0 else 1.0 / worst
 
+    def commit(self) -> None:
+        """The step converged: the interfaces' stick points (friction) become the converged ones."""
+        for itf in self.interfaces:
+            itf.commit()
+
     def on_converged(self) -> bool:
         """One Uzawa update on every augmented interface that needs it; True if any changed."""
         changed = any([itf.augment() for itf in self.interfaces])
@@ -828,7 +917,10 @@ class Contact(Contribution):
             cand = np.concatenate(self.comm.allgather(itf.candidates)).reshape(-1, 2)
             out[f"{k}_candidates"] = np.unique(cand, axis=0)
             kept = itf.kept_state()
-            if kept is not None:  # each rank's own slaves' faces
+            if itf.friction is not None:  # the stick points (the same on every rank)
+                out[f"{k}_stick_segment"] = itf.stick_segment.astype(float)
+                out[f"{k}_stick_xi"] = itf.stick_xi.copy()
+            elif kept is not None:  # each rank's own slaves' faces
                 mine = np.full(len(kept), -1)
                 mine[itf.mine] = kept[itf.mine]
                 out[f"{k}_kept"] = self.comm.allreduce(mine, op=MPI.MAX).astype(float)
@@ -851,6 +943,9 @@ class Contact(Contribution):
             itf.pairs_changed = True
             if f"{k}_kept" in arrays:
                 itf.restore_kept(arrays[f"{k}_kept"].astype(np.int64))
+            if f"{k}_stick_segment" in arrays:
+                itf.stick_segment[:] = arrays[f"{k}_stick_segment"].astype(np.int64)
+                itf.stick_xi[:] = arrays[f"{k}_stick_xi"]
             if f"{k}_anchor_slave" in arrays:
                 itf.anchor = (arrays[f"{k}_anchor_slave"].copy(), arrays[f"{k}_anchor_master"].copy())
 

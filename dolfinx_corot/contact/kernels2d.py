@@ -529,3 +529,16 @@ def slipped_stick_point(x, xi, xi0, t, eps_t):
         if abs(step) * la < 1e-14 * (1.0 + abs(target)):
             break
     return xi1
+
+
+@numba.njit(cache=True, error_model="numpy")
+def curve_points(x, xi):
+    """Points (k, 2) of the segments' curves at the parameters ξ (k,); x (k, 10) as in
+    :func:`node_to_smooth_segment` (the slave's entries unused)."""
+    k = x.shape[0]
+    out = np.empty((k, 2))
+    for i in range(k):
+        px, py, _, _, _, _, _, _ = _hermite(x[i], xi[i])
+        out[i, 0] = px
+        out[i, 1] = py
+    return out

@@ -7,9 +7,12 @@ r"""Normal contact laws (Wriggers 2006, §6.2 and §10.3; Simo & Laursen 1992).
 * :class:`AugmentedLagrangian` — p = ⟨λ − ε g⟩; after each converged
   Newton solve λ ← ⟨λ − ε g⟩ (Uzawa) until the largest penetration is below
   ``gap_tolerance`` · h; multipliers are carried over to the next step.
+
+The tangential law, :class:`Coulomb`, is given with either: ``Scene.contact(..., friction=...)``.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from .. import validate
@@ -47,3 +50,36 @@ class AugmentedLagrangian(Penalty):
         super().__post_init__()
         validate.positive("AugmentedLagrangian", "gap_tolerance", self.gap_tolerance)
         validate.whole("AugmentedLagrangian", "max_updates", self.max_updates, 0)
+
+
+@dataclass(frozen=True)
+class Coulomb:
+    """Coulomb friction with cohesion: the shear traction of a slave in contact is bounded by
+    τ ≤ c + μ σₙ, with μ = ``mu`` (structural users) or μ = tan φ from ``friction_angle`` φ in
+    degrees (geotechnical users; give one of the two) and ``cohesion`` c a stress (force per
+    unit area in 3D, per unit length in 2D, as the pressure). Below the bound the slave sticks
+    through a tangential penalty ε_T = ``tangential_factor`` · ε (ε the normal penalty): it slips
+    elastically by τ/ε_T before it slides."""
+
+    mu: float | None = None
+    friction_angle: float | None = None
+    cohesion: float = 0.0
+    tangential_factor: float = 1.0
+
+    def __post_init__(self):
+        if (self.mu is None) == (self.friction_angle is None):
+            raise ValueError("Coulomb: give the friction coefficient mu or the friction angle friction_angle "
+                             f"(degrees), one of them: got mu={self.mu}, friction_angle={self.friction_angle}")
+        if self.mu is not None:
+            validate.positive("Coulomb", "mu", self.mu, allow_zero=True)
+        else:
+            validate.positive("Coulomb", "friction_angle", self.friction_angle, allow_zero=True)
+            if not self.friction_angle < 90.0:
+                raise ValueError(f"Coulomb: friction_angle must be below 90 degrees, got {self.friction_angle}")
+        validate.positive("Coulomb", "cohesion", self.cohesion, allow_zero=True)
+        validate.positive("Coulomb", "tangential_factor", self.tangential_factor)
+
+    @property
+    def coefficient(self) -> float:
+        """μ (tan φ when given by the friction angle)."""
+        return float(self.mu) if self.mu is not None else math.tan(math.radians(self.friction_angle))

@@ -90,3 +90,34 @@ def test_friction_input_is_checked_by_name():
     solid = sc3.add_solid(box((1.0, 1.0, 1.0), (2, 2, 2), comm=comm), material=dc.Elastic(E, NU), degree=1)
     with pytest.raises(dc.ContactError, match="friction in 3D is not implemented yet"):
         sc3.contact((solid, "z1"), (solid, "z0"), friction=dc.Coulomb(mu=0.3))
+
+
+class _Killed(Exception):
+    """Raised from on_step: the run dies after a step (its checkpoint holds the step before)."""
+
+
+def test_a_restart_in_the_middle_of_sliding_is_exact(tmp_path):
+    """Killed at step 10 (partial slip: the stick points of the sticking and of the slipping slaves
+    are history) and restarted from the checkpoint of step 9: iterations, Uzawa updates and the
+    reactions of every step are the uninterrupted run's, the stick points too (1e-10)."""
+    def kill(row):
+        if row["step"] == 10:
+            raise _Killed
+
+    driver = dc.LoadControl(steps=STEPS)
+    law = dc.Coulomb(mu=0.3)
+    full_scene = _block_on_base(law)
+    full = dc.solve(full_scene, driver).history
+    path = comm.bcast(str(tmp_path / "friction.npz") if comm.rank == 0 else None, root=0)
+    with pytest.raises(_Killed):
+        dc.solve(_block_on_base(law), driver, checkpoint=path, on_step=kill)
+    resumed_scene = _block_on_base(law)
+    resumed = dc.solve(resumed_scene, driver, restart=path).history
+    for col in ("iterations", "uzawa_updates", "cuts"):
+        np.testing.assert_array_equal(resumed.column(col), full.column(col), err_msg=col)
+    for col in ("top_Fx", "top_Fy"):
+        np.testing.assert_allclose(resumed.column(col), full.column(col), rtol=1e-10, err_msg=col)
+    a, b = full_scene.interfaces[0], resumed_scene.interfaces[0]
+    assert (a.stick_segment >= 0).sum() > 0
+    np.testing.assert_array_equal(a.stick_segment, b.stick_segment)
+    np.testing.assert_allclose(a.stick_xi, b.stick_xi, rtol=1e-10, atol=1e-12)

@@ -6,7 +6,6 @@ the shallow two-bar (von Mises) truss with bars of constant EA on the engineerin
 P(w) = 2EA (1 − l/L)(h − w)/l, l = √(a² + (h − w)²), maximised over the apex deflection w.
 """
 import math
-import time
 
 import numpy as np
 import pytest
@@ -150,11 +149,10 @@ def _beam(fix):
 ])
 def test_a_structure_without_enough_supports_stops_at_the_first_solve(fix, motions):
     """No step halving: the first tangent is singular, the run stops at once and names the
-    part's free rigid motions (before: 'singular … Try smaller steps' after 8 cuts)."""
-    start = time.perf_counter()
+    part's free rigid motions (before: 'singular … Try smaller steps' after 8 cuts). Checked by
+    the count of cuts and steps, not by a wall time (a loaded machine made 1 s into 1.7 s)."""
     with pytest.raises(dc.SingularModelError, match="the model is singular before any load") as err:
         dc.solve(_beam(fix), dc.LoadControl(steps=2))
-    assert time.perf_counter() - start < 1.0
     assert f"beam 'beam' moves freely ({motions})" in str(err.value)
     assert "no support holds it" in str(err.value)
     assert err.value.result.totals["cuts"] == 0 and len(err.value.result.history) == 0
@@ -232,9 +230,7 @@ def test_duplicate_nodes_and_a_section_without_bending_stiffness_stop_at_the_fir
     b = sc.add_beam(tm, "beam", section=section, material=dc.Elastic(1.0e3))
     sc.fix(b, "base")
     sc.load(b, "tip", force=(0.0, -1.0))
-    start = time.perf_counter()
     with pytest.raises(dc.SingularModelError, match=r"beam 'beam' deforms without resistance \(a mechanism\): "
                                                     r"the node\(s\) at .*" + where) as err:
         dc.solve(sc, dc.LoadControl(steps=2))
-    assert time.perf_counter() - start < 1.0
     assert err.value.result.totals["cuts"] == 0 and len(err.value.result.history) == 0

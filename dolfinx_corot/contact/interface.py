@@ -42,6 +42,13 @@ from .search import broad_phase, narrow_phase
 logger = logging.getLogger(__name__)
 
 
+def fingerprint_float(value: float) -> float:
+    """``value`` to 12 significant digits, for a scene's fingerprint: a default penalty's last bits
+    follow the rounding of the surface's coordinates, which may differ from run to run under MPI
+    (4748.293279387663 and …662 in two runs of one scene on two ranks)."""
+    return float(f"{value:.12g}")
+
+
 def tributary_lengths(X: np.ndarray, segments: np.ndarray) -> np.ndarray:
     """Half the summed lengths of the segments at each node (the node's share of the boundary)."""
     length = np.linalg.norm(X[segments[:, 1]] - X[segments[:, 0]], axis=1)
@@ -593,7 +600,7 @@ class Interface:
     def describe(self) -> dict:
         """What defines the interface (for the scene's fingerprint and ``Scene.effects``)."""
         return {"slaves": self.slave_spec[1], "masters": self.master_spec[1], "law": repr(self.law),
-                "smooth": self.smooth, "penalty": self.penalty, "slave_nodes": len(self.area),
+                "smooth": self.smooth, "penalty": fingerprint_float(self.penalty), "slave_nodes": len(self.area),
                 "master_segments": len(self.master.facets),
                 **({"friction": repr(self.friction)} if self.friction is not None else {})}
 

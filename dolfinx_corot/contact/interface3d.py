@@ -42,7 +42,7 @@ import numpy as np
 from mpi4py import MPI
 
 from . import kernels3d, smooth3d
-from .interface import Interface
+from .interface import Interface, fingerprint_float
 from .laws import ContactError, Penalty
 from .search3d import broad_phase_boxes, face_boxes
 
@@ -413,5 +413,5 @@ class Interface3D(Interface):
 
     def describe(self) -> dict:
         return {"slaves": self.slave_spec[1], "masters": self.master_spec[1], "law": repr(self.law),
-                "smooth": self.smooth, "penalty": self.penalty, "slave_nodes": len(self.area),
+                "smooth": self.smooth, "penalty": fingerprint_float(self.penalty), "slave_nodes": len(self.area),
                 "master_segments": len(self.master.facets)}

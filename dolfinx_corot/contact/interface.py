@@ -235,8 +235,10 @@ class Interface:
                 seg[s[k]] = m[k]
                 xi0[s[k]] = (slipped_stick_point(x[k], xi[k], start[k], t[k], self.tangential_penalty) if slipping[k]
                              else start[k])
-        self.stick_segment = self.comm.allreduce(seg, op=MPI.MAX)
-        self.stick_xi = self.comm.allreduce(xi0, op=MPI.SUM)
+        self.stick_segment = np.empty_like(seg)
+        self.stick_xi = np.empty_like(xi0)
+        self.comm.Allreduce(seg, self.stick_segment, op=MPI.MAX)
+        self.comm.Allreduce(xi0, self.stick_xi, op=MPI.SUM)
         self.begin_step()
 
     def _stick_parameters(self, x: np.ndarray, s: np.ndarray, m: np.ndarray, xm: np.ndarray) -> np.ndarray:

@@ -14,7 +14,8 @@ contact evaluation the script times, summed over the two passes and taken on the
 * ``evaluate``: the whole contact evaluation (the above and the bookkeeping),
 
 and the step's wall time. Run it on one and on two ranks; each run writes
-output/contact_mpi_3d/ranks<N>.json and prints a table:
+output/contact_mpi_3d/ranks<N>.json, prints a table and plots every ranks<N>.json written so far
+(output/contact_mpi_3d/contact_mpi_3d.png):
 
     python benchmarks/contact_mpi_3d.py [--sizes 0.05 0.025 0.0125]
     mpirun -n 2 python benchmarks/contact_mpi_3d.py [--sizes ...]
@@ -125,13 +126,42 @@ def main():
         print(" h       dofs   slaves  faces  evals  wait ms  gather ms  search ms  pairs ms  evaluate ms  step s")
         for r in rows:
             print(f" {r['h']:<7g} {r['dofs']:<6d} {sum(r['slave_nodes']):<7d} {sum(r['master_faces']):<6d} "
-                  f"{r['evaluations']:<6d} {r['wait_ms']:<8.2f} {r['gather_ms']:<10.2f} {r['search_ms']:<10.2f} {r['pairs_ms']:<9.2f} "
+                  f"{r['evaluations']:<6d} {r['wait_ms']:<8.2f} {r['gather_ms']:<10.2f} {r['search_ms']:<10.2f} "
+                  f"{r['pairs_ms']:<9.2f} "
                   f"{r['evaluate_ms']:<12.2f} {r['wall_s']:.2f}")
     out = output_dir("contact_mpi_3d")
     if comm.rank == 0:
         with open(os.path.join(out, f"ranks{comm.size}.json"), "w") as f:
             json.dump({"ranks": comm.size, "rows": rows}, f, indent=2)
-        print(f"wrote {out}/ranks{comm.size}.json")
+        plot(out)
+        print(f"wrote {out}/ranks{comm.size}.json and {out}/contact_mpi_3d.png")
+
+
+def plot(out: str) -> None:
+    """Per-evaluation times against the master faces, for every ranks<N>.json written so far."""
+    import glob
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for path in sorted(glob.glob(os.path.join(out, "ranks*.json"))):
+        with open(path) as f:
+            data = json.load(f)
+        faces = [sum(r["master_faces"]) for r in data["rows"]]
+        style = "-" if data["ranks"] == 1 else "--"
+        for key, colour in (("evaluate_ms", "k"), ("pairs_ms", "C0"), ("search_ms", "C1"), ("gather_ms", "C2"),
+                            ("wait_ms", "C3")):
+            ax.loglog(faces, [r[key] for r in data["rows"]], style, color=colour, marker="o", ms=3,
+                      label=f"{key[:-3]}, {data['ranks']} rank(s)")
+    ax.set(xlabel="master faces (both passes)", ylabel="ms per contact evaluation (slowest rank)",
+           title="3D contact across ranks")
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "contact_mpi_3d.png"), dpi=120)
+    plt.close(fig)
 
 
 if __name__ == "__main__":

@@ -413,3 +413,206 @@ def closest_on_faces(xs, xm, faces, nodes, s, m, tol, out_xi, out_eta, out_dist,
         out_eta[i] = eta
         out_dist[i] = dist
         out_inside[i] = on
+
+
+# -- Coulomb friction -----------------------------------------------------------------------
+@numba.njit(cache=True)
+def _attach(x, k, y, n, xi, eta):
+    """(ξ, η) of the point X(ξ) = Σ N_a(ξ) x_a of the face (nodes x[1 … k], the bilinear surface
+    extended beyond the face) on the line through y along n: (I − n nᵀ)(y − X(ξ)) = 0, by
+    Gauss–Newton from (ξ, η); real."""
+    N = np.empty(k)
+    dN = np.empty((k, 2))
+    e = np.empty(3)
+    a1 = np.empty(3)
+    a2 = np.empty(3)
+    for it in range(_NEWTON_ITERATIONS):
+        shape(k, xi, eta, N, dN)
+        for d in range(3):
+            e[d] = y[d]
+            a1[d] = 0.0
+            a2[d] = 0.0
+            for a in range(k):
+                e[d] -= N[a] * x[1 + a, d]
+                a1[d] += dN[a, 0] * x[1 + a, d]
+                a2[d] += dN[a, 1] * x[1 + a, d]
+        xi, eta, step = tangent_step(a1, a2, e, n, xi, eta)
+        if step < 1e-14:
+            break
+    return xi, eta
+
+
+@numba.njit(cache=True)
+def tangent_step(a1, a2, e, n, xi, eta):
+    """One Gauss–Newton step for P (a1 dξ + a2 dη) = P e, P = I − n nᵀ (least squares in the
+    tangent plane of n; along a1, a2 alone where P a1, P a2 are parallel): (ξ + dξ, η + dη, |d|)."""
+    en = e[0] * n[0] + e[1] * n[1] + e[2] * n[2]
+    b1n = a1[0] * n[0] + a1[1] * n[1] + a1[2] * n[2]
+    b2n = a2[0] * n[0] + a2[1] * n[1] + a2[2] * n[2]
+    m11 = m12 = m22 = r1 = r2 = 0.0
+    for d in range(3):
+        b1 = a1[d] - b1n * n[d]
+        b2 = a2[d] - b2n * n[d]
+        pe = e[d] - en * n[d]
+        m11 += b1 * b1
+        m12 += b1 * b2
+        m22 += b2 * b2
+        r1 += b1 * pe
+        r2 += b2 * pe
+    det = m11 * m22 - m12 * m12
+    if det > 1e-12 * m11 * m22:
+        dxi = (m22 * r1 - m12 * r2) / det
+        deta = (m11 * r2 - m12 * r1) / det
+    elif m11 >= m22 and m11 > 0.0:  # the face seen edge-on along n: along its longer tangent
+        dxi, deta = r1 / m11, 0.0
+    elif m22 > 0.0:
+        dxi, deta = 0.0, r2 / m22
+    else:
+        return xi, eta, 0.0
+    return xi + dxi, eta + deta, abs(dxi) + abs(deta)
+
+
+@numba.njit(cache=True)
+def _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, cohesion, xi0, eta0, f, t, n):
+    """Gap, pressure and slip state of one frictional pair with its force f (3 (1 + k),), traction
+    t (3,) and contact normal n (3,) (the module's friction law); returns (g, p, slipping)."""
+    dt = x.dtype
+    zero = x[0, 0] * 0.0
+    N = np.empty(k, dtype=dt)
+    g = _contact_point(x, k, mode, which, side, N, n) - offset
+    p = lam - eps * g
+    for j in range(len(f)):
+        f[j] = 0.0
+    for d in range(3):
+        t[d] = 0.0
+    if p.real <= 0.0:
+        return g, zero, False
+    N0 = np.empty(k)
+    dN0 = np.empty((k, 2))
+    shape(k, xi0, eta0, N0, dN0)
+    s = np.empty(3, dtype=dt)
+    rn = zero
+    for d in range(3):
+        s[d] = x[0, d]
+        for a in range(k):
+            s[d] -= N0[a] * x[1 + a, d]
+        rn += s[d] * n[d]
+    ss = zero
+    for d in range(3):
+        s[d] -= rn * n[d]
+        ss += s[d] * s[d]
+    norm = np.sqrt(ss)
+    cap = cohesion + mu * p
+    slipping = eps_t * norm.real > cap.real
+    for d in range(3):
+        t[d] = cap * s[d] / norm if slipping else eps_t * s[d]
+        f[d] = -area * p * n[d] + area * t[d]
+        for a in range(k):
+            f[3 + 3 * a + d] = area * N[a] * (p * n[d] - t[d])
+    return g, p, slipping
+
+
+@numba.njit(cache=True)
+def node_to_face_friction(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, cohesion, attach, y, xi0,
+                          tangent, f, K, t, n, touch=0.0):
+    r"""Frictional contact of one slave x[0] with a face (nodes x[1 … k]) in ``mode`` at ``which``
+    on ``side`` (as :func:`node_to_face`): Coulomb's law with cohesion.
+
+    Normally as :func:`node_to_face`: contact point x_c = Σ N_a x_a, unit normal n, gap g,
+    pressure p = ⟨λ − εg⟩. Tangentially the slave is attached to a material point of the face,
+    its stick point X₀ = Σ N_a(ξ₀) x_a (ξ₀ = (ξ₀, η₀) in the face's parameters, the face's
+    surface extended beyond its edges), which moves with the face's nodes. The elastic slip is
+    the part of x_s − X₀ in the tangent plane at the contact point, s = (I − n nᵀ)(x_s − X₀) =
+    (I − n nᵀ)(x_c − X₀): the chord from the stick point to the contact point, in the plane of
+    the face (exactly that chord on a flat face). It depends on relative positions only: rigid
+    motions rotate it with the pair (frame indifference). The traction (force per tributary
+    area A) is the elastic predictor ε_T s returned onto Coulomb's cone |t| ≤ c + μ p: t = ε_T s
+    in stick, t = (c + μ p) s/|s| in slip (radial return). It acts on the slave and, opposite,
+    at the contact point of the face: f_s = A(−p n + t), f_a = A N_a (p n − t) (linear momentum
+    conserved; the couple A (x_s − x_c) × t, of the order of the penetration times the traction,
+    is that of the usual node-to-surface friction which leaves out the gap's share of the slip's
+    variation). K = ∂f/∂x by complex-step differentiation, stick or slip decided on the real
+    parts: consistent and, in slip, unsymmetric. (Wriggers, Computational Contact Mechanics,
+    2nd ed., Springer 2006, §5.2 and §9.1: the return map of Coulomb's law and node-to-surface
+    frictional contact; Laursen, Computational Contact and Impact Mechanics, Springer 2002,
+    §5.3: frame-indifferent tangential kinematics.)
+
+    ``attach`` 1: the stick point is first put (from the real configuration, then held fixed for
+    the tangent) where the line through y (3,) along the contact normal meets the face's surface
+    (y the slave: a slave that has just closed starts without slip; y a stick point on another
+    face: a slave that has passed to this face keeps its point); 0: ξ₀ is given. ``xi0`` (2,) in
+    and out. Returns (g, p, slipping); t (3,) the traction, n (3,) the normal. An open pair: as
+    :func:`node_to_face` (with its touch band), t zero."""
+    g, p, slipping = _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, cohesion,
+                                     xi0[0], xi0[1], f, t, n)
+    if p <= 0.0:
+        g = node_to_face(x, k, mode, which, side, offset, lam, eps, area, tangent, f, K, touch)
+        return g, 0.0, False
+    if attach:  # from the face's centre
+        xi0[0], xi0[1] = _attach(x, k, y, n, 1.0 / 3.0 if k == 3 else 0.0, 1.0 / 3.0 if k == 3 else 0.0)
+        g, p, slipping = _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, cohesion,
+                                         xi0[0], xi0[1], f, t, n)
+    if tangent:
+        m = 3 * (1 + k)
+        xc = x.astype(np.complex128)
+        fc = np.empty(m, dtype=np.complex128)
+        tc = np.empty(3, dtype=np.complex128)
+        nc = np.empty(3, dtype=np.complex128)
+        for j in range(m):
+            node, d = divmod(j, 3)
+            xc[node, d] += 1j * H
+            _friction_force(xc, k, mode, which, side, offset, lam + 0j, eps, area, eps_t, mu, cohesion,
+                            xi0[0], xi0[1], fc, tc, nc)
+            xc[node, d] = x[node, d]
+            for i in range(m):
+                K[i, j] = fc[i].imag / H
+    return g, p, slipping
+
+
+@numba.njit(cache=True)
+def pairs_to_faces_friction(xs, xm, faces, nodes, s, m, mode, which, side, offset, lam, eps, area, eps_t, mu,
+                            cohesion, attach, y, xi0, tangent, g, p, slipping, t, n, f, K, touch=0.0):
+    """node_to_face_friction for pairs (slave s[i], face m[i]) as :func:`pairs_to_faces`; attach,
+    y (p, 3), xi0 (p, 2) (in and out), p, slipping, t (p, 3), n (p, 3) per pair."""
+    for i in range(len(s)):
+        k = nodes[m[i]]
+        x = np.empty((1 + k, 3))
+        x[0] = xs[s[i]]
+        for a in range(k):
+            x[1 + a] = xm[faces[m[i], a]]
+        fi = np.zeros(3 * (1 + k))
+        Ki = np.zeros((3 * (1 + k), 3 * (1 + k)))
+        g[i], p[i], slipping[i] = node_to_face_friction(x, k, mode[i], which[i], side[i], offset[i], lam[i], eps[i],
+                                                        area[i], eps_t, mu, cohesion, attach[i], y[i], xi0[i],
+                                                        tangent, fi, Ki, t[i], n[i], touch)
+        f[i, :] = 0.0
+        K[i, :, :] = 0.0
+        f[i, : 3 * (1 + k)] = fi
+        K[i, : 3 * (1 + k), : 3 * (1 + k)] = Ki
+
+
+@numba.njit(cache=True)
+def attach_on_faces(xm, faces, nodes, m, y, n, xi0):
+    """The stick points (ξ₀, η₀) in xi0 (p, 2) (start in, result out) on faces m (p,) where the
+    lines through y (p, 3) along n (p, 3) meet them (the return map's new stick point after a
+    slip, y = x_s − t/ε_T)."""
+    for i in range(len(m)):
+        k = nodes[m[i]]
+        x = np.empty((1 + k, 3))
+        for a in range(k):
+            x[1 + a] = xm[faces[m[i], a]]
+        xi0[i, 0], xi0[i, 1] = _attach(x, k, y[i], n[i], xi0[i, 0], xi0[i, 1])
+
+
+@numba.njit(cache=True)
+def face_points(xm, faces, nodes, m, xi0, out):
+    """The points Σ N_a(ξ₀) x_a (p, 3) of faces m (p,) at the parameters xi0 (p, 2)."""
+    for i in range(len(m)):
+        k = nodes[m[i]]
+        N = np.empty(k)
+        dN = np.empty((k, 2))
+        shape(k, xi0[i, 0], xi0[i, 1], N, dN)
+        for d in range(3):
+            out[i, d] = 0.0
+            for a in range(k):
+                out[i, d] += N[a] * xm[faces[m[i], a], d]

@@ -47,7 +47,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .kernels3d import H, project, shape
+from .kernels3d import H, project, shape, tangent_step
 
 _NEWTON_ITERATIONS = 30
 
@@ -266,17 +266,15 @@ def _weights(x, k, xc, nu, xi, eta, N):
 
 
 @numba.njit(cache=True)
-def _force(x, k, star, nstar, side, offset, lam, eps, area, xi0, eta0, t0, f):
-    """Gap and force f (3 (1 + W),) of one pair along the normal field (module docstring), the
-    point sought from (ξ0, η0, t0); f zero beyond the face's nodes."""
+def _normal_force(x, k, star, nstar, side, offset, lam, eps, area, xi0, eta0, t0, f, nn, nu, N):
+    """Gap, pressure and force f (3 (1 + W),) of one pair along the normal field (module docstring),
+    the point sought from (ξ0, η0, t0); f zero beyond the face's nodes; into nn (k, 3) the nodal
+    normals, nu (3,) the unit normal ν, N (k,) the face nodes' weights. Returns (g, p, ξ, η)."""
     dt = x.dtype
-    nn = np.empty((k, 3), dtype=dt)
     nodal_normals(x, k, star, nstar, nn)
     xi, eta, t, _ = normal_point(x, k, nn, xi0 + 0.0 * x[0, 0], eta0 + 0.0 * x[0, 0], t0 + 0.0 * x[0, 0])
-    N = np.empty(k, dtype=dt)
     dN = np.empty((k, 2), dtype=dt)
     shape(k, xi, eta, N, dN)
-    nu = np.empty(3, dtype=dt)
     norm = _normal_field(k, N, nn, nu)
     sign = -1.0 if side < 0.0 else 1.0
     for d in range(3):
@@ -296,7 +294,17 @@ def _force(x, k, star, nstar, side, offset, lam, eps, area, xi0, eta0, t0, f):
         f[d] = -area * p * nu[d]
         for a in range(k):
             f[3 + 3 * a + d] = area * p * N[a] * nu[d]
-    return g
+    return g, p, xi, eta
+
+
+@numba.njit(cache=True)
+def _force(x, k, star, nstar, side, offset, lam, eps, area, xi0, eta0, t0, f):
+    """Gap and force f (3 (1 + W),) of one pair along the normal field (:func:`_normal_force`)."""
+    dt = x.dtype
+    nn = np.empty((k, 3), dtype=dt)
+    nu = np.empty(3, dtype=dt)
+    N = np.empty(k, dtype=dt)
+    return _normal_force(x, k, star, nstar, side, offset, lam, eps, area, xi0, eta0, t0, f, nn, nu, N)[0]
 
 
 @numba.njit(cache=True)
@@ -459,3 +467,149 @@ def build_stencils(X: np.ndarray, facets: np.ndarray, sharp: float) -> tuple[np.
         if w <= W and n <= S:
             return ext[:, :w], star[:, :, :n], nstar
         W, S = max(W, w), max(S, n)
+
+
+# -- Coulomb friction on the smoothed master ---------------------------------------------------
+@numba.njit(cache=True)
+def _friction_force(x, k, star, nstar, side, offset, lam, eps, area, eps_t, mu, cohesion, xs0, es0, xi, eta, tt,
+                    f, t, n):
+    """Gap, pressure and slip state of one frictional pair along the normal field, with its force
+    f (3 (1 + W),), traction t (3,) and normal n = ν (3,), the stick point at (ξ₀, η₀) = (xs0, es0)
+    on the face's patch, the contact point sought from (ξ, η, tt); returns (g, p, slipping)."""
+    dt = x.dtype
+    nn = np.empty((k, 3), dtype=dt)
+    N = np.empty(k, dtype=dt)
+    g, p, _, _ = _normal_force(x, k, star, nstar, side, offset, lam, eps, area, xi, eta, tt, f, nn, n, N)
+    for d in range(3):
+        t[d] = 0.0
+    if p.real <= 0.0:
+        return g, p, False
+    X0 = np.empty(3, dtype=dt)
+    t1 = np.empty(3, dtype=dt)
+    t2 = np.empty(3, dtype=dt)
+    zero = x[0, 0] * 0.0
+    surface(x, k, nn, xs0 + zero, es0 + zero, X0, t1, t2)
+    s = np.empty(3, dtype=dt)
+    rn = zero
+    for d in range(3):
+        s[d] = x[0, d] - X0[d]
+        rn += s[d] * n[d]
+    ss = zero
+    for d in range(3):
+        s[d] -= rn * n[d]
+        ss += s[d] * s[d]
+    norm = np.sqrt(ss)
+    cap = cohesion + mu * p
+    slipping = eps_t * norm.real > cap.real
+    for d in range(3):
+        t[d] = cap * s[d] / norm if slipping else eps_t * s[d]
+        f[d] += area * t[d]
+        for a in range(k):
+            f[3 + 3 * a + d] -= area * N[a] * t[d]
+    return g, p, slipping
+
+
+@numba.njit(cache=True)
+def _attach_patch(x, k, nn, y, n, xi, eta):
+    """(ξ, η) of the point x(ξ) of the face's Nagata patch (extended beyond the face) on the line
+    through y along n, by Gauss–Newton from (ξ, η); real."""
+    X = np.empty(3)
+    a1 = np.empty(3)
+    a2 = np.empty(3)
+    e = np.empty(3)
+    for it in range(_NEWTON_ITERATIONS):
+        surface(x, k, nn, xi, eta, X, a1, a2)
+        for d in range(3):
+            e[d] = y[d] - X[d]
+        xi, eta, step = tangent_step(a1, a2, e, n, xi, eta)
+        if step < 1e-14:
+            break
+    return xi, eta
+
+
+@numba.njit(cache=True)
+def node_to_smooth_face_friction(x, k, rows, star, nstar, side, offset, lam, eps, area, eps_t, mu, cohesion, attach,
+                                 y, xi0, tangent, f, K, t, n, touch=0.0):
+    """Frictional contact of a slave x[0] with a smoothed face: the normal part as
+    :func:`node_to_smooth_face`, the tangential one as
+    :func:`~dolfinx_corot.contact.kernels3d.node_to_face_friction` with the stick point on the
+    face's Nagata patch, X₀ = x(ξ₀), the slip s = (I − ν νᵀ)(x_s − X₀) in the tangent plane of
+    the normal field's ν, and the traction's reaction on the face nodes with the normal force's
+    weights. ``attach``, y, xi0 (2,) as there (the stick point where the line through y along ν
+    meets the patch). Returns (g, p, slipping)."""
+    nn = np.empty((k, 3))
+    nodal_normals(x, k, star, nstar, nn)
+    xi, eta, tt = start_point(x, k, nn)
+    xi, eta, tt, ok = normal_point(x, k, nn, xi, eta, tt)
+    f[:] = 0.0
+    K[:, :] = 0.0
+    t[:] = 0.0
+    if not ok:
+        return np.inf, 0.0, False
+    g, p, slipping = _friction_force(x, k, star, nstar, side, offset, lam, eps, area, eps_t, mu, cohesion, xi0[0],
+                                     xi0[1], xi, eta, tt, f, t, n)
+    if p <= 0.0:
+        g, _, _ = node_to_smooth_face(x, k, rows, star, nstar, side, offset, lam, eps, area, tangent, f, K, touch)
+        return g, 0.0, False
+    if attach:
+        xi0[0], xi0[1] = _attach_patch(x, k, nn, y, n, xi, eta)
+        g, p, slipping = _friction_force(x, k, star, nstar, side, offset, lam, eps, area, eps_t, mu, cohesion,
+                                         xi0[0], xi0[1], xi, eta, tt, f, t, n)
+    if tangent:
+        m = 3 * (1 + rows)
+        xc = x.astype(np.complex128)
+        fc = np.empty(len(f), dtype=np.complex128)
+        tc = np.empty(3, dtype=np.complex128)
+        nc = np.empty(3, dtype=np.complex128)
+        for j in range(m):
+            node, d = divmod(j, 3)
+            xc[node, d] += 1j * H
+            _friction_force(xc, k, star, nstar, side, offset, lam + 0j, eps, area, eps_t, mu, cohesion, xi0[0],
+                            xi0[1], xi, eta, tt, fc, tc, nc)
+            xc[node, d] = x[node, d]
+            for i in range(m):
+                K[i, j] = fc[i].imag / H
+    return g, p, slipping
+
+
+@numba.njit(cache=True)
+def pairs_to_smooth_faces_friction(xs, xm, ext, nodes, star, nstar, s, m, side, offset, lam, eps, area, eps_t, mu,
+                                   cohesion, attach, y, xi0, tangent, g, p, slipping, t, n, f, K, touch=0.0):
+    """node_to_smooth_face_friction for pairs (slave s[i], face m[i]) as :func:`pairs_to_smooth_faces`;
+    attach, y (p, 3), xi0 (p, 2) (in and out), p, slipping, t (p, 3), n (p, 3) per pair."""
+    W = ext.shape[1]
+    x = np.empty((1 + W, 3))
+    for i in range(len(s)):
+        rows = _gather(xs, xm, ext, s[i], m[i], x)
+        g[i], p[i], slipping[i] = node_to_smooth_face_friction(
+            x, nodes[m[i]], rows, star[m[i]], nstar[m[i]], side[i], offset[i], lam[i], eps[i], area[i], eps_t, mu,
+            cohesion, attach[i], y[i], xi0[i], tangent, f[i], K[i], t[i], n[i], touch)
+
+
+@numba.njit(cache=True)
+def attach_on_patches(xm, ext, nodes, star, nstar, m, y, n, xi0):
+    """The stick points (ξ₀, η₀) in xi0 (p, 2) (start in, result out) on the patches of faces m
+    where the lines through y (p, 3) along n (p, 3) meet them."""
+    W = ext.shape[1]
+    x = np.empty((1 + W, 3))
+    for i in range(len(m)):
+        _gather(y, xm, ext, i, m[i], x)
+        k = nodes[m[i]]
+        nn = np.empty((k, 3))
+        nodal_normals(x, k, star[m[i]], nstar[m[i]], nn)
+        xi0[i, 0], xi0[i, 1] = _attach_patch(x, k, nn, y[i], n[i], xi0[i, 0], xi0[i, 1])
+
+
+@numba.njit(cache=True)
+def patch_points(xm, ext, nodes, star, nstar, m, xi0, out):
+    """The points x(ξ₀) (p, 3) of the patches of faces m (p,) at the parameters xi0 (p, 2)."""
+    W = ext.shape[1]
+    x = np.empty((1 + W, 3))
+    for i in range(len(m)):
+        _gather(out, xm, ext, i, m[i], x)
+        k = nodes[m[i]]
+        nn = np.empty((k, 3))
+        nodal_normals(x, k, star[m[i]], nstar[m[i]], nn)
+        X = np.empty(3)
+        surface(x, k, nn, xi0[i, 0], xi0[i, 1], X, np.empty(3), np.empty(3))
+        out[i] = X

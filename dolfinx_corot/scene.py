@@ -333,14 +333,15 @@ class Scene:
         pressure integrated over the overlaps of slave and master faces, the nodal constraints
         weighted gaps; passes the patch test on non-matching faces, :mod:`~dolfinx_corot.contact.mortar`).
 
-        friction (2D node-to-segment): None (default, frictionless) or dc.Coulomb(mu=...) /
-        dc.Coulomb(friction_angle=..., cohesion=...): the shear traction bounded by c + μ p; each
-        slave sticks to a material point of the master (through a tangential penalty) until the
-        bound is reached, then slips; the stick points are history state (committed with each
-        step, restored with a cut step or a restart;
-        :func:`~dolfinx_corot.contact.kernels2d.node_to_smooth_segment_friction`). At a sharp
-        convex vertex of the master the pair is frictionless. The tangent is then not symmetric
-        (LU while the interface is engaged).
+        friction (node-to-segment, node-to-face): None (default, frictionless) or
+        dc.Coulomb(mu=...) / dc.Coulomb(friction_angle=..., cohesion=...): the shear traction
+        bounded by c + μ p; each slave sticks to a material point of the master (through a
+        tangential penalty) until the bound is reached, then slips; the stick points are history
+        state (committed with each step, restored with a cut step or a restart;
+        :func:`~dolfinx_corot.contact.kernels2d.node_to_smooth_segment_friction`,
+        :func:`~dolfinx_corot.contact.kernels3d.node_to_face_friction`). In 2D a sharp convex
+        vertex of the master is frictionless; in 3D faces, edges and vertices all carry friction.
+        The tangent is then not symmetric (LU while the interface is engaged).
 
         Returns a :class:`~dolfinx_corot.contact.ContactPair`, the sequence of the interfaces made
         (one, or two when symmetric), which gives the interface pressure of both passes combined
@@ -356,9 +357,9 @@ class Scene:
                                "straight segments passes the patch test: smooth=False)")
         else:
             kind, smooth = Interface, smooth is None or bool(smooth)
-        if friction is not None and kind is not Interface:
-            raise ContactError(f"contact '{slaves[1]} -> {masters[1]}': friction in 3D is not implemented yet "
-                               "(2D node-to-segment contact only)")
+        if friction is not None and kind is MortarInterface3D:
+            raise ContactError(f"contact '{slaves[1]} -> {masters[1]}': friction with the mortar discretization is "
+                               "not implemented: use discretization='node_to_face' for frictional contact")
         extra = {} if friction is None else {"friction": friction}
         made = [kind(slaves, masters, law, smooth, **extra)]
         if symmetric:

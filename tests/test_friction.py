@@ -68,7 +68,8 @@ def test_a_cohesive_interface_needs_c_times_the_contact_length_to_slide():
 
 def test_friction_input_is_checked_by_name():
     """Coulomb without a coefficient or with two, a negative or impossible one, friction that is
-    not a Coulomb law, and friction in 3D (not implemented yet) are refused by name."""
+    not a Coulomb law, and friction with the 3D mortar discretization (not implemented) are refused
+    by name."""
     with pytest.raises(ValueError, match="Coulomb: give the friction coefficient mu or the friction angle"):
         dc.Coulomb()
     with pytest.raises(ValueError, match="Coulomb: give the friction coefficient mu or the friction angle"):
@@ -88,8 +89,8 @@ def test_friction_input_is_checked_by_name():
         sc.contact((b, "b_bottom"), (b, "a_top"), friction=0.3)
     sc3 = dc.Scene()
     solid = sc3.add_solid(box((1.0, 1.0, 1.0), (2, 2, 2), comm=comm), material=dc.Elastic(E, NU), degree=1)
-    with pytest.raises(dc.ContactError, match="friction in 3D is not implemented yet"):
-        sc3.contact((solid, "z1"), (solid, "z0"), friction=dc.Coulomb(mu=0.3))
+    with pytest.raises(dc.ContactError, match="friction with the mortar discretization is not implemented"):
+        sc3.contact((solid, "z1"), (solid, "z0"), friction=dc.Coulomb(mu=0.3), discretization="mortar")
 
 
 class _Killed(Exception):

@@ -96,6 +96,7 @@ class Interface:
     SMOOTH_ANGLE = np.radians(60.0)  # master vertices where the surface turns more than this stay sharp
     BAND_USES = 3  # corrections per Newton solve that may count lifted pairs as closed
     SYMMETRIC_TANGENT = True
+    STICK_SHAPE = ()  # a stick point's parameters on its master facet: ξ on a segment's curve
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = True, friction: Coulomb | None = None):
         if not isinstance(law, Penalty):
@@ -152,7 +153,7 @@ class Interface:
         # the material point it is attached to (−1: none, the slave is not in contact); the last
         # converged state, the same on every rank
         self.stick_segment = np.full(len(self.area), -1)
-        self.stick_xi = np.zeros(len(self.area))
+        self.stick_xi = np.zeros((len(self.area),) + self.STICK_SHAPE)
         # within a step: the stick points the step's evaluations use (a slave that touches, or
         # passes to another segment, gets its point at the first evaluation that needs it and keeps
         # it until the step converges, so that the step's tangent is the derivative of its forces)
@@ -208,13 +209,22 @@ class Interface:
         self._update_existence()
 
     def kept_state(self):
-        """What a cut step restores besides the multipliers: the stick points (friction)."""
-        return (self.stick_segment.copy(), self.stick_xi.copy()) if self.friction is not None else None
+        """What a restore brings back besides the multipliers (friction): the committed stick
+        points and the step's own (a line search's restore within a step keeps the step's)."""
+        if self.friction is None:
+            return None
+        return (self.stick_segment.copy(), self.stick_xi.copy(), self.trial_segment.copy(), self.trial_xi.copy())
 
     def restore_kept(self, state) -> None:
         if state is not None:
-            self.stick_segment[:], self.stick_xi[:] = state
-            self.begin_step()
+            self.stick_segment, self.stick_xi, self.trial_segment, self.trial_xi = (a.copy() for a in state)
+
+    def kept_faces(self) -> np.ndarray | None:
+        """Each slave's master facet of the last evaluation, if the search keeps it (3D)."""
+        return None
+
+    def restore_faces(self, faces: np.ndarray) -> None:
+        """Sets what :meth:`kept_faces` returns (a restart)."""
 
     def begin_step(self) -> None:
         """A step (or its retry after a cut) starts from the converged stick points."""
@@ -925,14 +935,16 @@ class Contact(Contribution):
             out[f"{k}_gap_cancelled"] = itf.gap_cancelled.astype(float)
             cand = np.concatenate(self.comm.allgather(itf.candidates)).reshape(-1, 2)
             out[f"{k}_candidates"] = np.unique(cand, axis=0)
-            kept = itf.kept_state()
+            kept = itf.kept_faces()
             if itf.friction is not None:  # the stick points (the same on every rank)
                 out[f"{k}_stick_segment"] = itf.stick_segment.astype(float)
                 out[f"{k}_stick_xi"] = itf.stick_xi.copy()
-            elif kept is not None:  # each rank's own slaves' faces
-                mine = np.full(len(kept), -1)
+            if kept is not None:  # each rank's own slaves' faces
+                mine = np.full(len(kept), -1, dtype=np.int64)
                 mine[itf.mine] = kept[itf.mine]
-                out[f"{k}_kept"] = self.comm.allreduce(mine, op=MPI.MAX).astype(float)
+                every = np.empty_like(mine)
+                self.comm.Allreduce(mine, every, op=MPI.MAX)  # (a pickled MAX of arrays fails)
+                out[f"{k}_kept"] = every.astype(float)
             if itf.anchor is not None:
                 out[f"{k}_anchor_slave"], out[f"{k}_anchor_master"] = itf.anchor
         return out
@@ -951,10 +963,11 @@ class Contact(Contribution):
             itf.candidates = itf.own_pairs(cand)
             itf.pairs_changed = True
             if f"{k}_kept" in arrays:
-                itf.restore_kept(arrays[f"{k}_kept"].astype(np.int64))
+                itf.restore_faces(arrays[f"{k}_kept"].astype(np.int64))
             if f"{k}_stick_segment" in arrays:
                 itf.stick_segment[:] = arrays[f"{k}_stick_segment"].astype(np.int64)
-                itf.stick_xi[:] = arrays[f"{k}_stick_xi"]
+                itf.stick_xi[:] = arrays[f"{k}_stick_xi"].reshape(itf.stick_xi.shape)
+                itf.begin_step()
             if f"{k}_anchor_slave" in arrays:
                 itf.anchor = (arrays[f"{k}_anchor_slave"].copy(), arrays[f"{k}_anchor_master"].copy())
 

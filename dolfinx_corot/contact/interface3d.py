@@ -43,7 +43,7 @@ from mpi4py import MPI
 
 from . import kernels3d, smooth3d
 from .interface import Interface, fingerprint_float
-from .laws import ContactError, Penalty
+from .laws import ContactError, Coulomb, Penalty
 from .search3d import broad_phase_boxes, face_boxes
 
 PAIR_DOFS = kernels3d.PAIR_DOFS
@@ -80,9 +80,10 @@ class Interface3D(Interface):
     INSIDE_TOLERANCE = 1e-9  # a projection this far (in the face's parameters) beyond an edge is on it
     FREE_EDGE_TOLERANCE = 0.05  # a solid's slave beyond the surface's border: this far (× the face) still on it
     TOUCH_EVALUATIONS = 8  # evaluations of a Newton solve with the touch band's stiffness whatever the pairs
+    STICK_SHAPE = (2,)  # a stick point's parameters (ξ₀, η₀) on its master face
 
-    def __init__(self, slaves, masters, law: Penalty, smooth: bool = False):
-        super().__init__(slaves, masters, law, smooth)
+    def __init__(self, slaves, masters, law: Penalty, smooth: bool = False, friction: Coulomb | None = None):
+        super().__init__(slaves, masters, law, smooth, friction)
         if self.slave.dim == 1:  # a beam's nodes: its share of length times the section's width
             self.area = self.area * 2.0 * self.slave_face
         self._virtual = None
@@ -96,19 +97,28 @@ class Interface3D(Interface):
 
     @property
     def symmetric_tangent(self) -> bool:
-        """Along a smoothed master's normal field the force is not an energy's gradient."""
-        return self.SYMMETRIC_TANGENT and not self.smooth
+        """Along a smoothed master's normal field, and with friction, the force is not an energy's
+        gradient."""
+        return self.SYMMETRIC_TANGENT and not self.smooth and self.friction is None
 
     def bind(self, system) -> None:
         super().bind(system)
         self.previous_face = np.full(len(self.area), -1)
 
     def kept_state(self):
-        """What a cut step restores besides the multipliers: the faces of the last evaluation."""
-        return self.previous_face.copy()
+        """What a cut step restores besides the multipliers: the faces of the last evaluation and
+        the stick points (friction)."""
+        return self.previous_face.copy(), super().kept_state()
 
     def restore_kept(self, state) -> None:
-        self.previous_face[:] = state
+        self.previous_face[:] = state[0]
+        super().restore_kept(state[1])
+
+    def kept_faces(self) -> np.ndarray:
+        return self.previous_face
+
+    def restore_faces(self, faces: np.ndarray) -> None:
+        self.previous_face[:] = faces
 
     def _init_master(self) -> None:
         """The master faces padded to four nodes (a triangle's fourth is its first), the nodes of
@@ -276,7 +286,10 @@ class Interface3D(Interface):
         self.active[:] = -1
         self.active[s] = m
         lam = self.multiplier[s]
-        g, f, K = self._pairs(xs, xm, s, m, mode[s], which[s], side[s], lam, True)
+        if self.friction is not None:
+            g, f, K = self._friction_pairs(xs, xm, s, m, mode[s], which[s], side[s], lam)
+        else:
+            g, f, K = self._pairs(xs, xm, s, m, mode[s], which[s], side[s], lam, True)
         if self.first_evaluation:
             self.first_evaluation = False
             self.had_contact = bool(self.comm.allreduce(int(np.any(lam - self.penalty * g > 0.0)), op=MPI.MAX))
@@ -326,6 +339,98 @@ class Interface3D(Interface):
             g[i], f[i], K[i] = gi, fi, Ki
         return g, f, K
 
+    def _friction_pairs(self, xs, xm, s, m, mode, which, side, lam):
+        """As :meth:`_pairs` (with tangents) with Coulomb's traction at the closed pairs, each slave
+        against its step's stick point (attached, or carried to a new face, on first need and then
+        held until the step converges); keeps what :meth:`commit` needs."""
+        n = len(s)
+        law = self.friction
+        old = self.trial_segment[s]
+        xi0 = self.trial_xi[s].copy()
+        attach = (old != m).astype(np.int64)  # a slave that closes, or has passed to another face
+        y = xs[s].copy()
+        moved = np.flatnonzero((old >= 0) & (old != m))
+        if len(moved):  # its stick point, where it is now on its old face
+            y[moved] = self._stick_points(xm, old[moved], xi0[moved])
+        g, p, slipping = np.zeros(n), np.zeros(n), np.zeros(n, dtype=bool)
+        t, normal = np.zeros((n, 3)), np.zeros((n, 3))
+        f, K = np.zeros((n, self.width)), np.zeros((n, self.width, self.width))
+        offset = self.slave_offset[s] + self.master_offset[m]
+        eps = np.full(n, self.penalty)
+        eps_t, mu, c = self.tangential_penalty, law.coefficient, float(law.cohesion)
+        curved = (mode == 0) if self.smooth else np.zeros(n, dtype=bool)
+        for i in (np.flatnonzero(~curved), np.flatnonzero(curved)):
+            if not len(i):
+                continue
+            gi, pi, si = np.zeros(len(i)), np.zeros(len(i)), np.zeros(len(i), dtype=bool)
+            ti, ni, xii = np.zeros((len(i), 3)), np.zeros((len(i), 3)), xi0[i].copy()
+            if curved[i[0]]:
+                fi, Ki = np.zeros((len(i), self.width)), np.zeros((len(i), self.width, self.width))
+                smooth3d.pairs_to_smooth_faces_friction(
+                    xs, xm, self.ext, self.nodes, self.star, self.nstar, s[i], m[i], side[i], offset[i], lam[i], eps[i],
+                    self.area[s[i]], eps_t, mu, c, attach[i], y[i], xii, True, gi, pi, si, ti, ni, fi, Ki,
+                    self.touch)
+                f[i], K[i] = fi, Ki
+            else:
+                fi, Ki = np.zeros((len(i), PAIR_DOFS)), np.zeros((len(i), PAIR_DOFS, PAIR_DOFS))
+                kernels3d.pairs_to_faces_friction(
+                    xs, xm, self.faces, self.nodes, s[i], m[i], mode[i], which[i], side[i], offset[i], lam[i], eps[i],
+                    self.area[s[i]], eps_t, mu, c, attach[i], y[i], xii, True, gi, pi, si, ti, ni, fi, Ki,
+                    self.touch)
+                f[i, :PAIR_DOFS] = fi
+                K[i, :PAIR_DOFS, :PAIR_DOFS] = Ki
+            g[i], p[i], slipping[i], t[i], normal[i], xi0[i] = gi, pi, si, ti, ni, xii
+        closed = p > 0.0
+        changed = closed & (attach == 1)
+        self.trial_segment[s[changed]] = m[changed]
+        self.trial_xi[s[changed]] = xi0[changed]
+        self._friction_trial = (s[closed], m[closed], curved[closed], xi0[closed], slipping[closed], t[closed],
+                                normal[closed], xs[s[closed]])
+        return g, f, K
+
+    def _stick_points(self, xm: np.ndarray, faces: np.ndarray, xi0: np.ndarray) -> np.ndarray:
+        """The current positions (k, 3) of the stick points (ξ₀, η₀) on faces: of the flat faces, or
+        of their patches (smoothed master)."""
+        out = np.zeros((len(faces), 3))
+        if self.smooth:
+            smooth3d.patch_points(xm, self.ext, self.nodes, self.star, self.nstar, faces, xi0, out)
+        else:
+            kernels3d.face_points(xm, self.faces, self.nodes, faces, xi0, out)
+        return out
+
+    def commit(self) -> None:
+        """The step converged: each slave in contact keeps its stick point (sticking) or takes the
+        return map's: the point of its face on the line through x_s − t/ε_T along the normal, at
+        which the elastic slip is the traction over ε_T (slipping); a slave out of contact has
+        none. The same on every rank."""
+        if self.friction is None:
+            return
+        seg = np.full(len(self.area), -1)
+        xi0 = np.zeros((len(self.area), 2))
+        if self._friction_trial is not None:
+            s, m, curved, xi, slipping, t, normal, x_s = self._friction_trial
+            xi = xi.copy()
+            xm = self._x[1]
+            for on_patch in (False, True):
+                i = np.flatnonzero(slipping & (curved == on_patch))
+                if not len(i):
+                    continue
+                y = x_s[i] - t[i] / self.tangential_penalty
+                new = xi[i].copy()
+                if on_patch:
+                    smooth3d.attach_on_patches(xm, self.ext, self.nodes, self.star, self.nstar, m[i], y, normal[i],
+                                               new)
+                else:
+                    kernels3d.attach_on_faces(xm, self.faces, self.nodes, m[i], y, normal[i], new)
+                xi[i] = new
+            seg[s] = m
+            xi0[s] = xi
+        self.stick_segment = np.empty_like(seg)
+        self.stick_xi = np.empty_like(xi0)
+        self.comm.Allreduce(seg, self.stick_segment, op=MPI.MAX)
+        self.comm.Allreduce(xi0, self.stick_xi, op=MPI.SUM)
+        self.begin_step()
+
     def _idle(self, width: int):
         """No candidate pair on any rank: no pair, no force, no tangent (blocks of ``width`` dofs)."""
         none = np.zeros(0, dtype=np.int64)
@@ -333,6 +438,7 @@ class Interface3D(Interface):
         if self.first_evaluation:
             self.first_evaluation, self.had_contact = False, False
         self._virtual = None
+        self._friction_trial = None
         self._last = (none, np.zeros(0))
         self._forces = (none, none, np.zeros((0, width)))
         return np.zeros((0, width), dtype=np.int64), np.zeros((0, width)), np.zeros((0, width, width)), (none, none)
@@ -414,4 +520,5 @@ class Interface3D(Interface):
     def describe(self) -> dict:
         return {"slaves": self.slave_spec[1], "masters": self.master_spec[1], "law": repr(self.law),
                 "smooth": self.smooth, "penalty": fingerprint_float(self.penalty), "slave_nodes": len(self.area),
-                "master_segments": len(self.master.facets)}
+                "master_segments": len(self.master.facets),
+                **({"friction": repr(self.friction)} if self.friction is not None else {})}

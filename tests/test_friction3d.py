@@ -1,0 +1,104 @@
+"""Frictional contact in 3D (issue 16): an elastic block pressed onto a much stiffer base and pushed
+sideways, obliquely to the meshes, by its top. References: Coulomb's law (once the whole bottom
+slides, the tangential reaction is μ times the normal one, along the push), the elastic solution
+of the block with its bottom held while it sticks (a converged result of the same mesh)."""
+import numpy as np
+import pytest
+from mpi4py import MPI
+from test_contact3d import _slider_3d
+
+import dolfinx_corot as dc
+
+comm = MPI.COMM_WORLD
+E, NU, PRESS, STEPS = 1.0, 0.0, 0.01, 16
+SHIFT = np.array([0.02, 0.01])  # the push, oblique to both meshes
+
+
+def _pushed(tm, friction=None, held: bool = False, smooth: bool = False):
+    """The slider of :func:`test_contact3d._slider_3d` (1 × 1 × 0.5, spacing 0.25) on a base 10⁴
+    times stiffer (faces 0.5), pressed by the settlement of its top in the first step (p ≈ 0.01),
+    then pushed by SHIFT; one pass (the base hardly deforms); ``held``: the slider's bottom fixed
+    instead of contact (the sticking limit)."""
+    sc = dc.Scene(large_rotations=True, linear_solver="direct")
+    b = sc.add_solid(tm, "slider", material=dc.SaintVenantKirchhoff(E, NU), degree=1)
+    sc.add_solid(tm, "base_block", material=dc.SaintVenantKirchhoff(1e4 * E, NU), degree=1)
+    sc.fix(b, "base")
+    push = dc.Amplitude(((0.0, 0.0), (1 / STEPS, 0.0), (1.0, 1.0)))
+    sc.prescribe(b, "top", amplitude=push, ux=SHIFT[0], uy=SHIFT[1])
+    settle = dc.Amplitude(((0.0, 0.0), (1 / STEPS, 1.0), (1.0, 1.0)))
+    sc.prescribe(b, "top", amplitude=settle, uz=-PRESS * 0.5 * (1 + NU) * (1 - 2 * NU) / ((1 - NU) * E))
+    if held:
+        sc.fix(b, "slider_bottom")
+    else:
+        sc.contact((b, "slider_bottom"), (b, "base_top"), law=dc.AugmentedLagrangian(gap_tolerance=1e-8),
+                   smooth=smooth, friction=friction)
+    sc.monitor_reaction("top", b, "top")
+    return sc
+
+
+@pytest.mark.parametrize("quad, smooth", [(False, False), (True, False), (False, True)],
+                         ids=["triangles", "quadrilaterals", "smoothed"])
+def test_a_pressed_block_sticks_then_slides_with_mu_times_the_normal_force(quad, smooth):
+    """μ = 0.3 (tangential penalty 20 times the normal one), ν = 0 (no Poisson expansion under the
+    pressing: the held block is the sticking one), the push along (2, 1) over base faces of
+    triangles or quadrilaterals, flat or smoothed. In the first step of the push the block sticks:
+    its shear force is the held block's within 0.5 % (measured 0.26 % and 0.4 %: the tangential
+    penalty's compliance) and so is its pressing force (1e-4). The ratio of tangential to normal
+    force then grows until the whole bottom slides, over the last six steps at 0.3 to 1e-6 (Coulomb; measured
+    7e-8: the base, 10⁴ times stiffer, deforms), with the normal force constant (1e-5). The
+    friction force turns towards the push: the held block's reaction is 1.5 % off it (the tets'
+    anisotropy), the sliding block's direction error shrinks at every step (by about 0.7: the
+    radial return turns the traction by the trial's share of the new slip) to below 3e-4. No
+    cut; at most 25 Newton iterations a step (with up to 10 Uzawa updates), but for one step of
+    the quadrilateral base: 35, where a slave attached exactly at a base vertex, whose
+    equilibrium sticks within 6e-6 of that point, is thrown by the iterates from one face around
+    the vertex to the other (the slip tangent has no stiffness along the slip) for 20 iterations
+    until one falls within that range."""
+    tm = _slider_3d(quad)
+    h = dc.solve(_pushed(tm, dc.Coulomb(mu=0.3, tangential_factor=20.0), smooth=smooth),
+                 dc.LoadControl(steps=STEPS)).history
+    held = dc.solve(_pushed(tm, held=True), dc.LoadControl(steps=STEPS)).history
+    Fx, Fy, Fz = h.column("top_Fx"), h.column("top_Fy"), h.column("top_Fz")
+    iterations = h.column("iterations")
+    assert h.column("cuts").sum() == 0 and np.sort(iterations)[-2] <= 25 and iterations.max() <= 40, iterations
+    for col, F in (("top_Fx", Fx), ("top_Fy", Fy)):
+        assert F[1] == pytest.approx(held.column(col)[1], rel=0.005)
+    assert Fz[1] == pytest.approx(held.column("top_Fz")[1], rel=1e-4)
+    ratio = np.hypot(Fx, Fy) / -Fz
+    sliding = slice(-6, None)  # (the ratio approaches 0.3 from step 5 on as the stick zone vanishes)
+    assert np.abs(ratio[sliding] / 0.3 - 1.0).max() < 1e-6, ratio
+    assert np.ptp(Fz[sliding]) < 1e-5 * abs(Fz[-1])
+    direction = np.abs(Fy[sliding] / Fx[sliding] - 0.5)
+    assert np.all(np.diff(direction) < 0.0) and direction[-1] < 3e-4, direction
+
+
+class _Killed(Exception):
+    """Raised from on_step: the run dies after a step (its checkpoint holds the step before)."""
+
+
+def test_a_restart_in_the_middle_of_sliding_is_exact(tmp_path):
+    """Killed at step 5 (partial slip: the stick points of the sticking and of the slipping slaves
+    are history) and restarted from the checkpoint of step 4: iterations, Uzawa updates and the
+    reactions of every step are the uninterrupted run's, the stick points too (1e-10)."""
+    def kill(row):
+        if row["step"] == 5:
+            raise _Killed
+
+    tm = _slider_3d(False)
+    driver = dc.LoadControl(steps=STEPS)
+    law = dc.Coulomb(mu=0.3, tangential_factor=20.0)
+    full_scene = _pushed(tm, law)
+    full = dc.solve(full_scene, driver).history
+    path = comm.bcast(str(tmp_path / "friction3d.npz") if comm.rank == 0 else None, root=0)
+    with pytest.raises(_Killed):
+        dc.solve(_pushed(tm, law), driver, checkpoint=path, on_step=kill)
+    resumed_scene = _pushed(tm, law)
+    resumed = dc.solve(resumed_scene, driver, restart=path).history
+    for col in ("iterations", "uzawa_updates", "cuts"):
+        np.testing.assert_array_equal(resumed.column(col), full.column(col), err_msg=col)
+    for col in ("top_Fx", "top_Fy", "top_Fz"):
+        np.testing.assert_allclose(resumed.column(col), full.column(col), rtol=1e-10, err_msg=col)
+    a, b = full_scene.interfaces[0], resumed_scene.interfaces[0]
+    assert (a.stick_segment >= 0).sum() > 0
+    np.testing.assert_array_equal(a.stick_segment, b.stick_segment)
+    np.testing.assert_allclose(a.stick_xi, b.stick_xi, rtol=1e-10, atol=1e-12)

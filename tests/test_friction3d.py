@@ -96,8 +96,9 @@ def test_a_restart_in_the_middle_of_sliding_is_exact(tmp_path):
     resumed = dc.solve(resumed_scene, driver, restart=path).history
     for col in ("iterations", "uzawa_updates", "cuts"):
         np.testing.assert_array_equal(resumed.column(col), full.column(col), err_msg=col)
-    for col in ("top_Fx", "top_Fy", "top_Fz"):
-        np.testing.assert_allclose(resumed.column(col), full.column(col), rtol=1e-10, err_msg=col)
+    for col in ("top_Fx", "top_Fy", "top_Fz"):  # (atol: the round-off of the forces before the push, 1e-11)
+        F = full.column(col)
+        np.testing.assert_allclose(resumed.column(col), F, rtol=1e-10, atol=1e-10 * np.abs(F).max(), err_msg=col)
     a, b = full_scene.interfaces[0], resumed_scene.interfaces[0]
     assert (a.stick_segment >= 0).sum() > 0
     np.testing.assert_array_equal(a.stick_segment, b.stick_segment)

@@ -10,6 +10,7 @@ from scipy.spatial.transform import Rotation
 
 from dolfinx_corot.contact import kernels3d as k3
 from dolfinx_corot.contact import smooth3d as s3
+from test_smooth3d import _cap
 
 EPS, AREA, EPS_T = 100.0, 0.7, 80.0
 
@@ -142,18 +143,6 @@ def test_the_return_maps_stick_point_carries_the_traction(k, mode, which, slave)
 
 
 # -- the smoothed master --------------------------------------------------------------------------
-def _cap(quad: bool, R: float = 3.0, n: int = 4, h: float = 0.5, seed: int = 3):
-    s = np.arange(n) * h - (n - 1) * h / 2
-    X = np.array([[x, y, np.sqrt(R * R - x * x - y * y) - R] for y in s for x in s])
-    X += np.random.default_rng(seed).normal(0.0, h / 20, X.shape)
-    faces = []
-    for j in range(n - 1):
-        for i in range(n - 1):
-            a, b, c, d = j * n + i, j * n + i + 1, (j + 1) * n + i + 1, (j + 1) * n + i
-            faces += [[a, b, c, d]] if quad else [[a, b, c], [a, c, d]]
-    return X, np.array(faces)
-
-
 def _smooth(x, k, rows, star, nstar, xi0, mu=0.3, cohesion=0.0, side=0.0, lam=0.0, tangent=False, attach=0,
             y=None):
     m = 3 * len(x)
@@ -174,7 +163,7 @@ def test_smoothed_master_tangent_in_stick_and_slip(quad, where, dxi0, cohesion, 
     """On a shaken spherical cap's Nagata patches: K = ∂f/∂x over the slave and the stencil by
     central differences (1e-6); forces in balance; in slip |t| = c + μ p (1e-13), t ⟂ ν; a slave
     attached where it is has no traction and the frictionless smoothed kernel's force (1e-13)."""
-    X, F = _cap(quad)
+    X, F = _cap(quad, seed=3)
     face = 4 if quad else 9
     ext, star, nstar = s3.build_stencils(X, F, np.radians(60.0))
     c = X[F[face]].mean(axis=0)

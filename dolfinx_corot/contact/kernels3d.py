@@ -293,6 +293,17 @@ def node_to_face(x, k, mode, which, side, offset, lam, eps, area, tangent, f, K,
 
 
 @numba.njit(cache=True)
+def _face_pair(point, xm, faces, nodes, face):
+    """A pair's coordinates x (1 + k, 3): the point (a slave), then the nodes of face ``face``."""
+    k = nodes[face]
+    x = np.empty((1 + k, 3))
+    x[0] = point
+    for a in range(k):
+        x[1 + a] = xm[faces[face, a]]
+    return x
+
+
+@numba.njit(cache=True)
 def pairs_to_faces(xs, xm, faces, nodes, s, m, mode, which, side, offset, lam, eps, area, tangent, g, f, K,
                    touch=0.0):
     """node_to_face for pairs (slave s[i], face m[i]) on side[i] of slaves xs (ns, 3) against faces (nf, 4)
@@ -301,10 +312,7 @@ def pairs_to_faces(xs, xm, faces, nodes, s, m, mode, which, side, offset, lam, e
     :func:`node_to_face`."""
     for i in range(len(s)):
         k = nodes[m[i]]
-        x = np.empty((1 + k, 3))
-        x[0] = xs[s[i]]
-        for a in range(k):
-            x[1 + a] = xm[faces[m[i], a]]
+        x = _face_pair(xs[s[i]], xm, faces, nodes, m[i])
         fi = np.zeros(3 * (1 + k))
         Ki = np.zeros((3 * (1 + k), 3 * (1 + k)))
         g[i] = node_to_face(x, k, mode[i], which[i], side[i], offset[i], lam[i], eps[i], area[i], tangent, fi, Ki,
@@ -473,6 +481,29 @@ def tangent_step(a1, a2, e, n, xi, eta):
 
 
 @numba.njit(cache=True)
+def coulomb_traction(xs, X0, n, p, eps_t, mu, cohesion, t):
+    """Coulomb's traction t (3,) of a slave at xs attached to the stick point X0, contact normal n,
+    pressure p: the elastic slip s = (I − n nᵀ)(xs − X0), the predictor ε_T s returned radially
+    onto the cone |t| ≤ c + μ p. Real or complex (decided on the real
+    parts); returns whether the slave slips."""
+    s = np.empty(3, dtype=t.dtype)
+    rn = xs[0] * 0.0
+    for d in range(3):
+        s[d] = xs[d] - X0[d]
+        rn += s[d] * n[d]
+    ss = rn * 0.0
+    for d in range(3):
+        s[d] -= rn * n[d]
+        ss += s[d] * s[d]
+    norm = np.sqrt(ss)
+    cap = cohesion + mu * p
+    slipping = eps_t * norm.real > cap.real
+    for d in range(3):
+        t[d] = cap * s[d] / norm if slipping else eps_t * s[d]
+    return slipping
+
+
+@numba.njit(cache=True)
 def _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, cohesion, xi0, eta0, f, t, n):
     """Gap, pressure and slip state of one frictional pair with its force f (3 (1 + k),), traction
     t (3,) and contact normal n (3,) (the module's friction law); returns (g, p, slipping)."""
@@ -490,22 +521,12 @@ def _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, 
     N0 = np.empty(k)
     dN0 = np.empty((k, 2))
     shape(k, xi0, eta0, N0, dN0)
-    s = np.empty(3, dtype=dt)
-    rn = zero
+    X0 = np.zeros(3, dtype=dt)
     for d in range(3):
-        s[d] = x[0, d]
         for a in range(k):
-            s[d] -= N0[a] * x[1 + a, d]
-        rn += s[d] * n[d]
-    ss = zero
+            X0[d] += N0[a] * x[1 + a, d]
+    slipping = coulomb_traction(x[0], X0, n, p, eps_t, mu, cohesion, t)
     for d in range(3):
-        s[d] -= rn * n[d]
-        ss += s[d] * s[d]
-    norm = np.sqrt(ss)
-    cap = cohesion + mu * p
-    slipping = eps_t * norm.real > cap.real
-    for d in range(3):
-        t[d] = cap * s[d] / norm if slipping else eps_t * s[d]
         f[d] = -area * p * n[d] + area * t[d]
         for a in range(k):
             f[3 + 3 * a + d] = area * N[a] * (p * n[d] - t[d])
@@ -576,10 +597,7 @@ def pairs_to_faces_friction(xs, xm, faces, nodes, s, m, mode, which, side, offse
     y (p, 3), xi0 (p, 2) (in and out), p, slipping, t (p, 3), n (p, 3) per pair."""
     for i in range(len(s)):
         k = nodes[m[i]]
-        x = np.empty((1 + k, 3))
-        x[0] = xs[s[i]]
-        for a in range(k):
-            x[1 + a] = xm[faces[m[i], a]]
+        x = _face_pair(xs[s[i]], xm, faces, nodes, m[i])
         fi = np.zeros(3 * (1 + k))
         Ki = np.zeros((3 * (1 + k), 3 * (1 + k)))
         g[i], p[i], slipping[i] = node_to_face_friction(x, k, mode[i], which[i], side[i], offset[i], lam[i], eps[i],
@@ -597,11 +615,8 @@ def attach_on_faces(xm, faces, nodes, m, y, n, xi0):
     lines through y (p, 3) along n (p, 3) meet them (the return map's new stick point after a
     slip, y = x_s − t/ε_T)."""
     for i in range(len(m)):
-        k = nodes[m[i]]
-        x = np.empty((1 + k, 3))
-        for a in range(k):
-            x[1 + a] = xm[faces[m[i], a]]
-        xi0[i, 0], xi0[i, 1] = _attach(x, k, y[i], n[i], xi0[i, 0], xi0[i, 1])
+        x = _face_pair(y[i], xm, faces, nodes, m[i])
+        xi0[i, 0], xi0[i, 1] = _attach(x, nodes[m[i]], y[i], n[i], xi0[i, 0], xi0[i, 1])
 
 
 @numba.njit(cache=True)

@@ -47,7 +47,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .kernels3d import H, project, shape, tangent_step
+from .kernels3d import H, coulomb_traction, project, shape, tangent_step
 
 _NEWTON_ITERATIONS = 30
 
@@ -489,20 +489,8 @@ def _friction_force(x, k, star, nstar, side, offset, lam, eps, area, eps_t, mu, 
     t2 = np.empty(3, dtype=dt)
     zero = x[0, 0] * 0.0
     surface(x, k, nn, xs0 + zero, es0 + zero, X0, t1, t2)
-    s = np.empty(3, dtype=dt)
-    rn = zero
+    slipping = coulomb_traction(x[0], X0, n, p, eps_t, mu, cohesion, t)
     for d in range(3):
-        s[d] = x[0, d] - X0[d]
-        rn += s[d] * n[d]
-    ss = zero
-    for d in range(3):
-        s[d] -= rn * n[d]
-        ss += s[d] * s[d]
-    norm = np.sqrt(ss)
-    cap = cohesion + mu * p
-    slipping = eps_t * norm.real > cap.real
-    for d in range(3):
-        t[d] = cap * s[d] / norm if slipping else eps_t * s[d]
         f[d] += area * t[d]
         for a in range(k):
             f[3 + 3 * a + d] -= area * N[a] * t[d]
@@ -587,29 +575,32 @@ def pairs_to_smooth_faces_friction(xs, xm, ext, nodes, star, nstar, s, m, side, 
 
 
 @numba.njit(cache=True)
+def _patch(point, xm, ext, nodes, star, nstar, face, x):
+    """Gathers into x (1 + W, 3) the point (row 0) and the stencil of face ``face``; returns the
+    face's nodes k and their nodal normals (k, 3)."""
+    x[0] = point
+    for j in range(ext.shape[1]):
+        x[1 + j] = xm[ext[face, j]] if ext[face, j] >= 0 else point
+    k = nodes[face]
+    nn = np.empty((k, 3))
+    nodal_normals(x, k, star[face], nstar[face], nn)
+    return k, nn
+
+
+@numba.njit(cache=True)
 def attach_on_patches(xm, ext, nodes, star, nstar, m, y, n, xi0):
     """The stick points (ξ₀, η₀) in xi0 (p, 2) (start in, result out) on the patches of faces m
     where the lines through y (p, 3) along n (p, 3) meet them."""
-    W = ext.shape[1]
-    x = np.empty((1 + W, 3))
+    x = np.empty((1 + ext.shape[1], 3))
     for i in range(len(m)):
-        _gather(y, xm, ext, i, m[i], x)
-        k = nodes[m[i]]
-        nn = np.empty((k, 3))
-        nodal_normals(x, k, star[m[i]], nstar[m[i]], nn)
+        k, nn = _patch(y[i], xm, ext, nodes, star, nstar, m[i], x)
         xi0[i, 0], xi0[i, 1] = _attach_patch(x, k, nn, y[i], n[i], xi0[i, 0], xi0[i, 1])
 
 
 @numba.njit(cache=True)
 def patch_points(xm, ext, nodes, star, nstar, m, xi0, out):
     """The points x(ξ₀) (p, 3) of the patches of faces m (p,) at the parameters xi0 (p, 2)."""
-    W = ext.shape[1]
-    x = np.empty((1 + W, 3))
+    x = np.empty((1 + ext.shape[1], 3))
     for i in range(len(m)):
-        _gather(out, xm, ext, i, m[i], x)
-        k = nodes[m[i]]
-        nn = np.empty((k, 3))
-        nodal_normals(x, k, star[m[i]], nstar[m[i]], nn)
-        X = np.empty(3)
-        surface(x, k, nn, xi0[i, 0], xi0[i, 1], X, np.empty(3), np.empty(3))
-        out[i] = X
+        k, nn = _patch(xm[ext[m[i], 0]], xm, ext, nodes, star, nstar, m[i], x)
+        surface(x, k, nn, xi0[i, 0], xi0[i, 1], out[i], np.empty(3), np.empty(3))

@@ -79,7 +79,11 @@ class _Killed(Exception):
 def test_a_restart_in_the_middle_of_sliding_is_exact(tmp_path):
     """Killed at step 5 (partial slip: the stick points of the sticking and of the slipping slaves
     are history) and restarted from the checkpoint of step 4: iterations, Uzawa updates and the
-    reactions of every step are the uninterrupted run's, the stick points too (1e-10)."""
+    reactions of every step are the uninterrupted run's, the stick points too (1e-10). Under MPI
+    the parallel direct solver's round-off is not the same from one run to the next (two
+    uninterrupted runs in one process differ by 1e-14 in the forces); a frictional step's
+    iteration count follows it where a slave is at the limit of stick and slip: there, the
+    counts within one and the reactions and stick points within 1e-8 of the uninterrupted run."""
     def kill(row):
         if row["step"] == 5:
             raise _Killed
@@ -94,12 +98,14 @@ def test_a_restart_in_the_middle_of_sliding_is_exact(tmp_path):
         dc.solve(_pushed(tm, law), driver, checkpoint=path, on_step=kill)
     resumed_scene = _pushed(tm, law)
     resumed = dc.solve(resumed_scene, driver, restart=path).history
+    serial = comm.size == 1
+    tol = 1e-10 if serial else 1e-8
     for col in ("iterations", "uzawa_updates", "cuts"):
-        np.testing.assert_array_equal(resumed.column(col), full.column(col), err_msg=col)
+        np.testing.assert_allclose(resumed.column(col), full.column(col), atol=0 if serial else 1, err_msg=col)
     for col in ("top_Fx", "top_Fy", "top_Fz"):  # (atol: the round-off of the forces before the push, 1e-11)
         F = full.column(col)
-        np.testing.assert_allclose(resumed.column(col), F, rtol=1e-10, atol=1e-10 * np.abs(F).max(), err_msg=col)
+        np.testing.assert_allclose(resumed.column(col), F, rtol=tol, atol=tol * np.abs(F).max(), err_msg=col)
     a, b = full_scene.interfaces[0], resumed_scene.interfaces[0]
     assert (a.stick_segment >= 0).sum() > 0
     np.testing.assert_array_equal(a.stick_segment, b.stick_segment)
-    np.testing.assert_allclose(a.stick_xi, b.stick_xi, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(a.stick_xi, b.stick_xi, rtol=tol, atol=0.01 * tol)

@@ -206,6 +206,7 @@ class Interface:
         self.had_contact = False
         self.band_used = 0
         self._virtual = None
+        self.step_start = None  # slave and master positions at the start of the step (friction)
         self._update_existence()
 
     def kept_state(self):
@@ -231,6 +232,14 @@ class Interface:
         self.trial_segment = self.stick_segment.copy()
         self.trial_xi = self.stick_xi.copy()
 
+    def note_step_start(self, converged: bool = False) -> None:
+        """Keeps the slave and master positions of the last converged configuration (friction: a
+        slave that touches in a step is attached where it was at the step's start, see
+        :meth:`evaluate`): at a commit (``converged``), or at the start of a run's first step or of
+        the first step after a restart (before any predictor moves the nodes). Collective."""
+        if self.friction is not None and (converged or self.step_start is None):
+            self.step_start = (self._positions(self.slave), self._positions(self.master))
+
     def commit(self) -> None:
         """The step converged: each slave in contact keeps its stick point (sticking) or takes the
         return map's (slipping: the point at the elastic distance t/ε_T behind it); a slave out of
@@ -250,18 +259,26 @@ class Interface:
         self.comm.Allreduce(seg, self.stick_segment, op=MPI.MAX)
         self.comm.Allreduce(xi0, self.stick_xi, op=MPI.SUM)
         self.begin_step()
+        self.note_step_start(converged=True)
 
     def _stick_parameters(self, x: np.ndarray, s: np.ndarray, m: np.ndarray, xm: np.ndarray) -> np.ndarray:
         """The parameters ξ₀ (n,) of the slaves' stick points on the curves of their segments m
-        (pairs x (n, 10); master positions xm): the committed one on the same segment; a slave that comes into contact
-        is attached where it touches (no slip yet); one that has passed to another segment takes
-        the closest point of that segment's curve to its stick point (a constant of the step's
-        tangent: its dependence on the old segment's nodes is left out)."""
+        (pairs x (n, 10); master positions xm): the committed one on the same segment; a slave that
+        comes into contact is attached where it was at the step's start, projected onto the
+        segment's curve as it was then (a material point of the master, whatever path the iterates
+        take); one that has passed to another segment takes the closest point of that segment's
+        curve to its stick point (a constant of the step's tangent: its dependence on the old
+        segment's nodes is left out)."""
         xi0 = self.trial_xi[s].copy()
         old = self.trial_segment[s]
         _, now, _ = smooth_gap(x)
         new = old < 0
         xi0[new] = now[new]
+        if new.any() and self.step_start is not None:  # (None: evaluated outside a step)
+            xs0, xm0 = self.step_start
+            ext = self.ext[m[new]]
+            _, then, ok = smooth_gap(np.hstack([xs0[s[new]]] + [xm0[ext[:, j]] for j in range(4)]))
+            xi0[new] = np.where(ok, then, now[new])
         moved = np.flatnonzero(~new & (old != m))
         if len(moved):
             ext = self.ext[old[moved]]
@@ -527,8 +544,10 @@ class Interface:
             g[i], _, _, f[i], K[i], _, normal[i] = node_to_smooth_segment(x, sides[s[i]], offset, lam[i], eps[i],
                                                                           self.area[s[i]], True, touch)
             if self.friction is not None:  # the pairs with a pressure: Coulomb's law on the same curve
+                # (a pressure below the touch band's, the round-off of bodies that touch unloaded,
+                # has no friction: its cone, of that size, would turn the traction with the round-off)
                 law = self.friction
-                closed = np.flatnonzero(lam[i] - eps[i] * g[i] > 0.0)
+                closed = np.flatnonzero(lam[i] - eps[i] * g[i] > self.penalty * self.touch)
                 j = i[closed]
                 xj = x[closed]
                 start = self._stick_parameters(xj, s[j], m[j], xm)
@@ -846,6 +865,7 @@ class Contact(Contribution):
             itf.uzawa_updates = 0
             itf.after_update = False
             itf.begin_step()
+            itf.note_step_start()
 
     def before_solve(self) -> None:
         """A Newton solve starts: its first tangent is the exact one; each interface notes whether
@@ -968,6 +988,7 @@ class Contact(Contribution):
                 itf.stick_segment[:] = arrays[f"{k}_stick_segment"].astype(np.int64)
                 itf.stick_xi[:] = arrays[f"{k}_stick_xi"].reshape(itf.stick_xi.shape)
                 itf.begin_step()
+                itf.step_start = None  # (taken when the next step starts, from the restored state)
             if f"{k}_anchor_slave" in arrays:
                 itf.anchor = (arrays[f"{k}_anchor_slave"].copy(), arrays[f"{k}_anchor_master"].copy())
 

@@ -216,7 +216,10 @@ class Interface3D(Interface):
         if valid.any():
             v = np.flatnonzero(valid)
             other = np.ones(len(v), dtype=np.int64) if prefer is None else (prefer[s[v]] != m[v]).astype(np.int64)
-            order = np.lexsort((m[v], np.abs(g[v]), other, s[v]))
+            # the nearest face, of faces equally near to 1e-9 h (a slave on an edge or a vertex) the
+            # lowest-numbered: the choice does not depend on the round-off (of a rank's layout)
+            near = np.round(np.abs(g[v]) / (1e-9 * self.h))
+            order = np.lexsort((m[v], near, other, s[v]))
             first = v[order][np.r_[True, np.diff(s[v[order]]) != 0]]
             face[s[first]] = m[first]
             side[s[first]] = sides[first]
@@ -344,44 +347,65 @@ class Interface3D(Interface):
         against its step's stick point (attached, or carried to a new face, on first need and then
         held until the step converges); keeps what :meth:`commit` needs."""
         n = len(s)
-        law = self.friction
         old = self.trial_segment[s]
         xi0 = self.trial_xi[s].copy()
         attach = (old != m).astype(np.int64)  # a slave that closes, or has passed to another face
         y = xs[s].copy()
+        new = np.flatnonzero(old < 0)
+        if len(new):  # a slave that closes: attached where it was at the step's start, projected
+            # onto its face as it was then (a material point of the face: whatever path the
+            # iterates take, the same point)
+            xs0, xm0 = self.step_start if self.step_start is not None else (xs, xm)  # (None: outside a step)
+            k = len(new)
+            xi, eta, dist, on = np.zeros(k), np.zeros(k), np.zeros(k), np.zeros(k, dtype=bool)
+            kernels3d.closest_on_faces(xs0, xm0, self.faces, self.nodes, s[new], m[new], self.INSIDE_TOLERANCE, xi,
+                                       eta, dist, on)
+            xi0[new, 0], xi0[new, 1] = xi, eta
+            attach[new] = 0
         moved = np.flatnonzero((old >= 0) & (old != m))
         if len(moved):  # its stick point, where it is now on its old face
             y[moved] = self._stick_points(xm, old[moved], xi0[moved])
+        offset = self.slave_offset[s] + self.master_offset[m]
+        eps = np.full(n, self.penalty)
+        curved = (mode == 0) if self.smooth else np.zeros(n, dtype=bool)
+
+        def kernels(i, mu, c, attach, xi0):
+            """(g, p, slipping, t, n, ξ₀, f, K) of the pairs i (flat faces or patches, with Coulomb's
+            coefficient mu and cohesion c)."""
+            k = len(i)
+            out = (np.zeros(k), np.zeros(k), np.zeros(k, dtype=bool), np.zeros((k, 3)), np.zeros((k, 3)),
+                   xi0.copy(), np.zeros((k, self.width)), np.zeros((k, self.width, self.width)))
+            gi, pi, si, ti, ni, xii, fi, Ki = out
+            args = (s[i], m[i])
+            if self.smooth and k and curved[i[0]]:
+                smooth3d.pairs_to_smooth_faces_friction(
+                    xs, xm, self.ext, self.nodes, self.star, self.nstar, *args, side[i], offset[i], lam[i], eps[i],
+                    self.area[s[i]], self.tangential_penalty, mu, c, attach, y[i], xii, True, gi, pi, si, ti, ni, fi,
+                    Ki, self.touch)
+            elif k:
+                ff, KK = np.zeros((k, PAIR_DOFS)), np.zeros((k, PAIR_DOFS, PAIR_DOFS))
+                kernels3d.pairs_to_faces_friction(
+                    xs, xm, self.faces, self.nodes, *args, mode[i], which[i], side[i], offset[i], lam[i], eps[i],
+                    self.area[s[i]], self.tangential_penalty, mu, c, attach, y[i], xii, True, gi, pi, si, ti, ni, ff,
+                    KK, self.touch)
+                fi[:, :PAIR_DOFS], Ki[:, :PAIR_DOFS, :PAIR_DOFS] = ff, KK
+            return out
+
         g, p, slipping = np.zeros(n), np.zeros(n), np.zeros(n, dtype=bool)
         t, normal = np.zeros((n, 3)), np.zeros((n, 3))
         f, K = np.zeros((n, self.width)), np.zeros((n, self.width, self.width))
-        offset = self.slave_offset[s] + self.master_offset[m]
-        eps = np.full(n, self.penalty)
-        eps_t, mu, c = self.tangential_penalty, law.coefficient, float(law.cohesion)
-        curved = (mode == 0) if self.smooth else np.zeros(n, dtype=bool)
+        mu, c = self.friction.coefficient, float(self.friction.cohesion)
         for i in (np.flatnonzero(~curved), np.flatnonzero(curved)):
-            if not len(i):
-                continue
-            gi, pi, si = np.zeros(len(i)), np.zeros(len(i)), np.zeros(len(i), dtype=bool)
-            ti, ni, xii = np.zeros((len(i), 3)), np.zeros((len(i), 3)), xi0[i].copy()
-            if curved[i[0]]:
-                fi, Ki = np.zeros((len(i), self.width)), np.zeros((len(i), self.width, self.width))
-                smooth3d.pairs_to_smooth_faces_friction(
-                    xs, xm, self.ext, self.nodes, self.star, self.nstar, s[i], m[i], side[i], offset[i], lam[i], eps[i],
-                    self.area[s[i]], eps_t, mu, c, attach[i], y[i], xii, True, gi, pi, si, ti, ni, fi, Ki,
-                    self.touch)
-                f[i], K[i] = fi, Ki
-            else:
-                fi, Ki = np.zeros((len(i), PAIR_DOFS)), np.zeros((len(i), PAIR_DOFS, PAIR_DOFS))
-                kernels3d.pairs_to_faces_friction(
-                    xs, xm, self.faces, self.nodes, s[i], m[i], mode[i], which[i], side[i], offset[i], lam[i], eps[i],
-                    self.area[s[i]], eps_t, mu, c, attach[i], y[i], xii, True, gi, pi, si, ti, ni, fi, Ki,
-                    self.touch)
-                f[i, :PAIR_DOFS] = fi
-                K[i, :PAIR_DOFS, :PAIR_DOFS] = Ki
-            g[i], p[i], slipping[i], t[i], normal[i], xi0[i] = gi, pi, si, ti, ni, xii
+            g[i], p[i], slipping[i], t[i], normal[i], xi0[i], f[i], K[i] = kernels(i, mu, c, attach[i], xi0[i])
+        # a pressure below the touch band's (round-off at bodies that touch unloaded) has no
+        # friction: its cone, of that size, would turn the traction with the round-off
+        faint = np.flatnonzero((p > 0.0) & (p < self.penalty * self.touch))
+        if len(faint):
+            i = faint
+            g[i], f[i], K[i] = self._pairs(xs, xm, s[i], m[i], mode[i], which[i], side[i], lam[i], True)
+            p[i] = 0.0
         closed = p > 0.0
-        changed = closed & (attach == 1)
+        changed = closed & (old != m)
         self.trial_segment[s[changed]] = m[changed]
         self.trial_xi[s[changed]] = xi0[changed]
         self._friction_trial = (s[closed], m[closed], curved[closed], xi0[closed], slipping[closed], t[closed],
@@ -430,6 +454,7 @@ class Interface3D(Interface):
         self.comm.Allreduce(seg, self.stick_segment, op=MPI.MAX)
         self.comm.Allreduce(xi0, self.stick_xi, op=MPI.SUM)
         self.begin_step()
+        self.note_step_start(converged=True)
 
     def _idle(self, width: int):
         """No candidate pair on any rank: no pair, no force, no tangent (blocks of ``width`` dofs)."""

@@ -254,6 +254,12 @@ class Interface:
                 seg[s[k]] = m[k]
                 xi0[s[k]] = (slipped_stick_point(x[k], xi[k], start[k], t[k], self.tangential_penalty) if slipping[k]
                              else start[k])
+        self.commit_stick_points(seg, xi0)
+
+    def commit_stick_points(self, seg: np.ndarray, xi0: np.ndarray) -> None:
+        """The converged stick points: each rank's own slaves' segments or faces seg (−1 elsewhere)
+        and parameters xi0 (zero elsewhere), combined over the ranks (the same on every rank); the
+        next step starts from them and from the converged positions."""
         self.stick_segment = np.empty_like(seg)
         self.stick_xi = np.empty_like(xi0)
         self.comm.Allreduce(seg, self.stick_segment, op=MPI.MAX)

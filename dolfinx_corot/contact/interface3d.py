@@ -449,12 +449,7 @@ class Interface3D(Interface):
                 xi[i] = new
             seg[s] = m
             xi0[s] = xi
-        self.stick_segment = np.empty_like(seg)
-        self.stick_xi = np.empty_like(xi0)
-        self.comm.Allreduce(seg, self.stick_segment, op=MPI.MAX)
-        self.comm.Allreduce(xi0, self.stick_xi, op=MPI.SUM)
-        self.begin_step()
-        self.note_step_start(converged=True)
+        self.commit_stick_points(seg, xi0)
 
     def _idle(self, width: int):
         """No candidate pair on any rank: no pair, no force, no tangent (blocks of ``width`` dofs)."""

@@ -284,8 +284,10 @@ class Scene:
         density: mass per unit volume ρ; None: the density of the part's material
         (``dc.Elastic(E, nu, density=ρ)``).
 
-        * Solids: body force ρ·g per unit reference volume on the cells of ``where`` (all
-          cells of the mesh if None); with density None each cell's material gives ρ.
+        * Solids: body force ρ·g per unit reference volume on the cells of ``where``; None:
+          the part's own cells (its region, ``add_solid(mesh, "fill", …)``: only the fill; a
+          part added without a region: every cell of the mesh); with density None each
+          cell's material gives ρ.
         * Beams and bars: ρ·A·g per unit reference length; shells and membranes: ρ·t·g per
           unit reference area; on the elements of ``part`` (those in group ``where`` if
           given), as work-equivalent nodal loads computed from the reference geometry

@@ -156,7 +156,7 @@ def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
                 "no:cacheprovider", "--color=no", "tests/test_coupled.py", "tests/test_membrane_quad.py",
                 "tests/test_continuum.py", "tests/test_contact.py", "tests/test_contact3d.py",
                 "tests/test_contact3d_structures.py", "tests/test_mortar3d.py", "tests/test_contact_pressure.py",
-                "tests/test_restart.py", "tests/test_friction.py", "tests/test_friction3d.py",
+                "tests/test_restart.py", "tests/test_friction.py", "tests/test_friction3d.py", "tests/test_inclined_plane.py",
                 "tests/test_fields.py", "tests/test_reference.py", "tests/test_bad_input.py", "tests/test_monitors.py",
                 "tests/test_self_weight.py", "tests/test_cell_checks.py", "tests/test_stabilisation.py",
                 "tests/test_stability.py", "tests/test_convergence_scale.py", "tests/test_staging.py"],

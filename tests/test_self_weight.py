@@ -313,6 +313,25 @@ def test_solid_takes_the_density_of_each_region():
         assert abs(row["base_Fy"] - reaction) < 1e-10 * reaction
 
 
+def test_gravity_on_a_region_of_a_solid_loads_that_region_only():
+    """A part added with a region (``add_solid(mesh, "b", …)``) carries its own weight only:
+    gravity on it gives the reaction ρ₂ g V₂ (V₂ = 2), not the weight of every cell of the mesh;
+    ``where`` still names any group of cells."""
+    from dolfinx_corot.io.mesh import rectangles
+    tm = rectangles({"a": (0.0, 0.0, 1.0, 1.0, 2, 2), "b": (1.0, 0.0, 2.0, 1.0, 2, 2)},
+                    {"bottom": [("a", "bottom"), ("b", "bottom")]}, comm=comm)
+    rho1, rho2, g = 2.0, 3.0, 9.81
+    for where, reaction in ((None, g * rho2 * 2.0), ("a", g * rho1 * 1.0)):
+        sc = dc.Scene(large_rotations=False)
+        s = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(E, NU, density=rho1), degree=1)
+        b = sc.add_solid(tm, "b", material=dc.SaintVenantKirchhoff(E, NU, density=rho2), degree=1)
+        sc.fix(s, "bottom")
+        sc.gravity(b, (0.0, -g), where=where)
+        sc.monitor_reaction("base", s, "bottom")
+        row = dc.solve(sc, dc.LoadControl(steps=1)).history.rows[-1]
+        assert abs(row["base_Fy"] - reaction) < 1e-10 * reaction, (where, row["base_Fy"])
+
+
 def test_density_leaves_the_scene_description_unchanged():
     """Density and gravity are loads, not part of what defines the model: the scene's description
     (the fingerprint of its checkpoints) is the same with and without them; plane strain changes

@@ -377,6 +377,8 @@ class System:
 
         def add(dofs, K):
             d = np.asarray(dofs).astype(PETSc.IntType)
+            if d.shape[0] == 0:  # a rank with none of the contribution's dofs (PETSc divides by the row count)
+                return
             C.setValuesRCV(d, d, K, addv=PETSc.InsertMode.ADD_VALUES)
 
         for c in self.contributions:

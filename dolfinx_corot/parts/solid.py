@@ -180,8 +180,10 @@ class Solid(AdditiveState, Part):
 
     def add_gravity(self, part: PartRef, acceleration: np.ndarray, density: float | None, where: str | None,
                     amplitude=None, condition: Condition | None = None) -> Condition:
-        """Body force ρ·g per unit reference volume on the cells of ``where`` (all cells of the
-        mesh if None, whatever region ``part`` names); ``density`` None: each cell's material's."""
+        """Body force ρ·g per unit reference volume on the cells of ``where``; None: the cells of
+        ``part`` (its region, or all cells of the mesh for a part added without one); ``density``
+        None: each cell's material's."""
+        where = part.name or None if where is None else where
         condition = condition or Condition("gravity", f"on '{where or 'all cells'}'")
         return self.add_body_force(where, acceleration if density is None else density * acceleration, amplitude,
                                    material_density=density is None, condition=condition)

@@ -748,6 +748,32 @@ class Interface:
         x = self._positions(self.slave)
         return x, out * self.area / self._tributary(x, self.slave.facets)
 
+    def friction_traction(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The friction at the last evaluation, on every rank, for all slave nodes of this pass:
+        their reference coordinates (n, gdim), tangential traction (force per reference length
+        (area), as :meth:`pressure`) and whether they slip (n,) bool. In 2D the traction is the
+        scalar t along the master curve's unit tangent τ at the contact point (the direction of
+        its segments' numbering), positive where the slave has moved along τ from its stick point:
+        the force on the slave is −t τ per length; in 3D (n, 3), the traction vector t with the
+        force −t per area on the slave. Zero (and not slipping) at open slaves, and everywhere
+        without friction."""
+        n = len(self.area)
+        t = np.zeros((n, 3)) if self.slave.gdim == 3 else np.zeros(n)
+        slip = np.zeros(n)
+        if self._friction_trial is not None:
+            s, t_pairs, slipping = self._friction_state()
+            t[s] = t_pairs
+            slip[s] = slipping
+        out_t, out_slip = np.zeros_like(t), np.zeros_like(slip)
+        self.comm.Allreduce(t, out_t, op=MPI.SUM)
+        self.comm.Allreduce(slip, out_slip, op=MPI.SUM)
+        return self.slave.X, out_t, out_slip > 0.5
+
+    def _friction_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(slaves, tractions, slipping) of the closed pairs at the last evaluation, this rank's."""
+        s, m, x, xi, start, t, slipping, p = self._friction_trial
+        return s, t, slipping
+
     @property
     def contact_forces(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The pairs in contact at the last evaluation, this rank's: slave nodes (k,), their

@@ -412,6 +412,10 @@ class Interface3D(Interface):
                                 normal[closed], xs[s[closed]])
         return g, f, K
 
+    def _friction_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        s, m, curved, xi, slipping, t, normal, x_s = self._friction_trial
+        return s, t, slipping
+
     def _stick_points(self, xm: np.ndarray, faces: np.ndarray, xi0: np.ndarray) -> np.ndarray:
         """The current positions (k, 3) of the stick points (ξ₀, η₀) on faces: of the flat faces, or
         of their patches (smoothed master)."""

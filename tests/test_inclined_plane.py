@@ -63,7 +63,8 @@ def test_a_block_stays_on_a_tilting_table_until_tan_theta_is_mu_then_slides(dim)
     carries μ W to 1e-6 (the table's reaction, along the downhill direction to 1e-6), the
     springs the rest, and the block has moved more than 50 times the held block's displacement
     (measured 68 and 223 times). No cut."""
-    h = dc.solve(_tilted(dim, held=False), dc.LoadControl(steps=STEPS)).history
+    scene = _tilted(dim, held=False)
+    h = dc.solve(scene, dc.LoadControl(steps=STEPS)).history
     held = dc.solve(_tilted(dim, held=True), dc.LoadControl(steps=STEPS)).history
     axes = "xyz"[:dim]
     force = np.column_stack([h.column(f"table_F{a}") for a in axes])
@@ -84,3 +85,14 @@ def test_a_block_stays_on_a_tilting_table_until_tan_theta_is_mu_then_slides(dim)
     assert np.linalg.norm(force[-1, :-1] + ratio[-1] * force[-1, -1] * downhill) < 1e-6 * MU * abs(force[-1, -1])
     assert h.column("stab_force")[-1] > 1e-5
     assert along[-1] > 50.0 * along_held[-1]
+    # the slaves' friction (Interface.friction_traction): all slip, each at |t| = μ p, their
+    # tractions sum to the interface's force, μ N downhill (the force on the block is −t)
+    itf = scene.interfaces[0]
+    _, p = itf.pressure()
+    _, t, slipping = itf.friction_traction()
+    on = p > 0.0
+    assert on.sum() >= 5 and slipping[on].all() and not slipping[~on].any()
+    size = np.abs(t) if dim == 2 else np.linalg.norm(t, axis=1)
+    assert np.allclose(size[on], MU * p[on], rtol=1e-9, atol=0.0)
+    t_along = t if dim == 2 else t[:, :2] @ ALONG  # (in 2D along the base's numbering, here −x)
+    assert abs(np.sum(itf.area * t_along)) == pytest.approx(MU * abs(force[-1, -1]), rel=1e-6)

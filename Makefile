@@ -32,6 +32,7 @@ bench: setup
 	$(PY) benchmarks/contact_search.py             # 10⁴, 10⁵, 10⁶ slaves and segments
 	$(PY) benchmarks/contact_effects.py            # an idle interface's cost
 	$(PY) benchmarks/lining_soft_ground.py         # Newton iterations of contact in soft ground, three meshes
+	$(PY) benchmarks/friction.py --baseline 6245b6d^   # a block slid with friction; frictionless against the code before friction
 
 # numba's on-disk cache does not see edits of inlined callees in other modules
 clean-cache:

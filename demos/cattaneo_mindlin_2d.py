@@ -266,7 +266,8 @@ def plot(demo, rows, profiles):
            title="what accuracy costs")
     ax.legend(fontsize=7)
     demo.save(fig, "cattaneo_mindlin_2d.png")
-    demo.record(Q_over_muP=[r["Q_over_muP"] for r in rows], c=[r["c"] for r in rows],
+    demo.record(load_factor=[r["load_factor"] for r in rows], Q_over_muP=[r["Q_over_muP"] for r in rows],
+                c=[r["c"] for r in rows],
                 c_theory=[r["c_theory"] for r in rows], q_rms_error=[r["q_rms_error"] for r in rows])
 
 

@@ -16,7 +16,7 @@ frictionless interface.
    median wall times and the reactions are compared (target: the same time within the
    machine's noise, the same numbers to round-off).
 
-Writes output/friction/friction.{json,csv}.
+Writes output/friction/friction.{json,csv,png}.
 Usage: python benchmarks/friction.py [--meshes 32 16 70 35] [--baseline 6245b6d^] [--repeat 3]
 """
 import argparse
@@ -115,11 +115,12 @@ def main():
         return child(args)
     from dolfinx_corot.io import output_dir
 
-    rows = []
+    rows, histories = [], []
     for nx, ny in zip(args.meshes[::2], args.meshes[1::2]):
         run(nx, ny, True)  # compiles the kernels once
         r = run(nx, ny, True)
         rows.append({k: v for k, v in r.items() if not k.startswith("base_")})
+        histories.append(r)
         if comm.rank == 0:
             print(f"block {nx} × {ny}: {r['dofs']} dofs, |ΣF_t|/|ΣF_n| = {r['ratio']:.7f} (μ = {MU}), "
                   f"{r['newton_iterations']} Newton its {r['steps']}, Uzawa {r['uzawa']}, {r['cuts']} cuts, {r['wall_s']:.2f} s")
@@ -140,6 +141,29 @@ def main():
             fh.write(",".join(keys) + "\n")
             for r in rows:
                 fh.write(",".join(str(r[k]) for k in keys) + "\n")
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+        for r in histories:
+            ratio = np.abs(np.divide(r["base_Fx"], r["base_Fy"]))
+            axes[0].plot(np.arange(1, len(ratio) + 1), ratio, "o-", ms=3, label=f"{r['dofs']} dofs")
+        axes[0].axhline(MU, color="k", lw=0.8)
+        axes[0].set(xlabel="step", ylabel="|ΣF_t| / |ΣF_n| of the base", title="pressed, then pushed (line: μ)")
+        axes[0].legend(fontsize=7)
+        axes[1].loglog([r["dofs"] for r in histories], [r["wall_s"] for r in histories], "o-", label="this code")
+        axes[1].loglog([1600, 5300], [19.0, 49.0], "s--", label="CalculiX (issue 16)")
+        if "frictionless" in report:
+            f = report["frictionless"]
+            axes[1].plot([f["dofs"]] * 2, [np.median(f["current_s"]), np.median(f["baseline_s"])], "x", ms=8,
+                         label="frictionless: this code, before friction")
+        axes[1].set(xlabel="dofs", ylabel="wall time of the solve [s]", title="what sliding costs")
+        axes[1].legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(os.path.join(folder, "friction.png"), dpi=110)
+        plt.close(fig)
 
 
 if __name__ == "__main__":

@@ -73,8 +73,9 @@ def test_a_cohesive_interface_needs_c_times_the_contact_length_to_slide():
 
 def test_friction_input_is_checked_by_name():
     """Coulomb without a coefficient or with two, a negative or impossible one, friction that is
-    not a Coulomb law, and friction with the 3D mortar discretization (not implemented) are refused
-    by name."""
+    not a Coulomb law, a slip tolerance without an augmented-Lagrangian normal law (it would have
+    no effect) and friction with the 3D mortar discretization (not implemented) are refused by
+    name."""
     with pytest.raises(ValueError, match="Coulomb: give the friction coefficient mu or the friction angle"):
         dc.Coulomb()
     with pytest.raises(ValueError, match="Coulomb: give the friction coefficient mu or the friction angle"):
@@ -92,6 +93,10 @@ def test_friction_input_is_checked_by_name():
     b = sc.add_solid(tm, material=dc.Elastic(E, NU), degree=1)
     with pytest.raises(TypeError, match="contact friction must be dc.Coulomb"):
         sc.contact((b, "b_bottom"), (b, "a_top"), friction=0.3)
+    with pytest.raises(ValueError, match="slip_tolerance needs the augmented Lagrangian"):
+        sc.contact((b, "b_bottom"), (b, "a_top"), law=dc.Penalty(), friction=dc.Coulomb(mu=0.3, slip_tolerance=1e-3))
+    with pytest.raises(ValueError, match="Coulomb: slip_tolerance = 0.0 must be"):
+        dc.Coulomb(mu=0.3, slip_tolerance=0.0)
     sc3 = dc.Scene()
     solid = sc3.add_solid(box((1.0, 1.0, 1.0), (2, 2, 2), comm=comm), material=dc.Elastic(E, NU), degree=1)
     with pytest.raises(dc.ContactError, match="friction with the mortar discretization is not implemented"):
@@ -102,16 +107,18 @@ class _Killed(Exception):
     """Raised from on_step: the run dies after a step (its checkpoint holds the step before)."""
 
 
-def test_a_restart_in_the_middle_of_sliding_is_exact(tmp_path):
+@pytest.mark.parametrize("augmented", [False, True], ids=["penalty", "augmented"])
+def test_a_restart_in_the_middle_of_sliding_is_exact(tmp_path, augmented):
     """Killed at step 10 (partial slip: the stick points of the sticking and of the slipping slaves
     are history) and restarted from the checkpoint of step 9: iterations, Uzawa updates and the
-    reactions of every step are the uninterrupted run's, the stick points too (1e-10)."""
+    reactions of every step are the uninterrupted run's, the stick points and the tangential
+    multipliers too (1e-10); with the shear augmented as well."""
     def kill(row):
         if row["step"] == 10:
             raise _Killed
 
     driver = dc.LoadControl(steps=STEPS)
-    law = dc.Coulomb(mu=0.3)
+    law = dc.Coulomb(mu=0.3, slip_tolerance=1e-4 if augmented else None)
     full_scene = _block_on_base(law)
     full = dc.solve(full_scene, driver).history
     path = comm.bcast(str(tmp_path / "friction.npz") if comm.rank == 0 else None, root=0)
@@ -128,3 +135,5 @@ def test_a_restart_in_the_middle_of_sliding_is_exact(tmp_path):
     assert (a.stick_segment >= 0).sum() > 0
     np.testing.assert_array_equal(a.stick_segment, b.stick_segment)
     np.testing.assert_allclose(a.stick_xi, b.stick_xi, rtol=1e-10, atol=1e-12)
+    assert np.abs(a.stick_lambda).max() > 0.0
+    np.testing.assert_allclose(a.stick_lambda, b.stick_lambda, rtol=1e-10, atol=1e-10 * np.abs(a.stick_lambda).max())

@@ -27,14 +27,14 @@ CASES = [(0, 0, [0.3, 0.35, -0.02]), (1, 0, [0.5, -0.2, -0.03]), (1, 1, [0.9, 0.
 
 
 def _flat(x, k, mode, which, xi0, mu=0.3, cohesion=0.0, lam=0.0, side=0.0, tangent=False, attach=0, y=None,
-          offset=None):
+          offset=None, lam_t=(0.0, 0.0, 0.0)):
     m = 3 * (1 + k)
     f, K, t, n = np.zeros(m), np.zeros((m, m)), np.zeros(3), np.zeros(3)
     xi0 = np.array(xi0, float)
     y = np.zeros(3) if y is None else np.asarray(y, float)
     offset = (0.4 if side else 0.0) if offset is None else offset
     g, p, slipping = k3.node_to_face_friction(x, k, mode, which, side, offset, lam, EPS, AREA, EPS_T, mu, cohesion,
-                                              attach, y, xi0, tangent, f, K, t, n)
+                                              attach, y, xi0, np.array(lam_t, float), tangent, f, K, t, n)
     return dict(g=g, p=p, slipping=slipping, f=f, K=K, t=t, n=n, xi0=xi0)
 
 
@@ -51,15 +51,19 @@ def _fd(fun, x, h=1e-7):
 
 @pytest.mark.parametrize("k", [3, 4])
 @pytest.mark.parametrize("mode, which, slave", CASES)
-@pytest.mark.parametrize("dxi0, cohesion, side", [((0.001, -0.0008), 0.0, 0.0),  # stick
-                                                  ((0.2, 0.1), 0.0, 0.0),        # slip
-                                                  ((-0.1, 0.25), 0.4, 0.0),      # slip with cohesion
-                                                  ((0.2, -0.1), 0.0, 1.0)])      # slip, two-sided
-def test_the_tangent_is_the_derivative_of_the_force_in_stick_and_slip(k, mode, which, slave, dxi0, cohesion, side):
+@pytest.mark.parametrize("dxi0, cohesion, side, lam_t", [((0.001, -0.0008), 0.0, 0.0, (0, 0, 0)),   # stick
+                                                         ((0.001, -0.0008), 0.0, 0.0, (0.2, -0.1, 0.1)),  # λ_T
+                                                         ((0.2, 0.1), 0.0, 0.0, (0, 0, 0)),        # slip
+                                                         ((0.2, 0.1), 0.0, 0.0, (-1.0, 0.5, 0.3)),  # slip, λ_T
+                                                         ((-0.1, 0.25), 0.4, 0.0, (0, 0, 0)),      # cohesion
+                                                         ((0.2, -0.1), 0.0, 1.0, (0.5, 0.5, 0))])  # two-sided
+def test_the_tangent_is_the_derivative_of_the_force_in_stick_and_slip(k, mode, which, slave, dxi0, cohesion, side,
+                                                                      lam_t):
     """K = ∂f/∂x by central differences (h = 1e-7: 1e-6 of the largest entry) at faces, edges and
-    vertices of a triangle and a warped quadrilateral; the pair's forces sum to zero; in slip the
-    traction lies on Coulomb's cone (|t| = c + μ p to 1e-13) along the slip, and K is not
-    symmetric."""
+    vertices of a triangle and a warped quadrilateral, with and without a tangential multiplier
+    λ_T (its convected basis turns with the face: in the tangent); the pair's forces sum to
+    zero; in slip the traction lies on Coulomb's cone (|t| = c + μ p to 1e-13) along the slip,
+    and K is not symmetric."""
     rng = np.random.default_rng(5)
     x = np.vstack([slave, _face(k, rng)])
     if side:  # a shell's mid-surface: the slave 0.03 above it, its contact face at 0.4 (as test_contact3d_kernels)
@@ -67,13 +71,14 @@ def test_the_tangent_is_the_derivative_of_the_force_in_stick_and_slip(k, mode, w
     offset_lam = 3.0 if side else 0.0
     base = _flat(x, k, mode, which, (0.0, 0.0), attach=1, y=x[0], side=side, lam=offset_lam)
     xi0 = base["xi0"] + np.array(dxi0)
-    r = _flat(x, k, mode, which, xi0, cohesion=cohesion, side=side, lam=offset_lam, tangent=True)
+    r = _flat(x, k, mode, which, xi0, cohesion=cohesion, side=side, lam=offset_lam, tangent=True, lam_t=lam_t)
     assert r["p"] > 0.0
     if np.abs(dxi0).max() < 0.01:
         assert not r["slipping"]
-    elastic = _flat(x, k, mode, which, xi0, mu=1e9, side=side, lam=offset_lam)["t"]
+    elastic = _flat(x, k, mode, which, xi0, mu=1e9, side=side, lam=offset_lam, lam_t=lam_t)["t"]
     assert r["slipping"] == (np.linalg.norm(elastic) > cohesion + 0.3 * r["p"])
-    fd = _fd(lambda y: _flat(y, k, mode, which, xi0, cohesion=cohesion, side=side, lam=offset_lam)["f"], x)
+    fd = _fd(lambda y: _flat(y, k, mode, which, xi0, cohesion=cohesion, side=side, lam=offset_lam,
+                             lam_t=lam_t)["f"], x)
     assert np.abs(r["K"] - fd).max() < 1e-6 * np.abs(r["K"]).max()
     assert np.abs(r["f"].reshape(-1, 3).sum(axis=0)).max() < 1e-13 * np.abs(r["f"]).max()
     assert abs(r["t"] @ r["n"]) < 1e-13 * EPS_T  # (round-off of s = r₀ − (r₀·n) n, |r₀| ~ 1)
@@ -105,16 +110,19 @@ def test_without_slip_or_friction_the_kernel_is_the_frictionless_one(k, mode, wh
 @pytest.mark.parametrize("mode, which, slave", CASES[:3])
 def test_a_rigid_rotation_of_the_pair_rotates_its_forces(k, mode, which, slave):
     """Frame indifference: the pair turned by 2.3 rad about a skew axis and moved has its forces
-    and traction turned with it, the same pressure and the same stick/slip state (1e-12)."""
+    and traction turned with it, the same pressure and the same stick/slip state (1e-12), with
+    and without a tangential multiplier (held on the face's convected basis)."""
     x = np.vstack([slave, _face(k, np.random.default_rng(5))])
     Rm = Rotation.from_rotvec(2.3 * np.array([1.0, -2.0, 0.5]) / np.linalg.norm([1.0, -2.0, 0.5])).as_matrix()
     y = x @ Rm.T + np.array([3.0, -1.0, 2.0])
-    for dxi0 in ((0.004, 0.002), (0.2, -0.1)):
+    for dxi0, lam_t in (((0.004, 0.002), (0, 0, 0)), ((0.2, -0.1), (0, 0, 0)), ((0.004, 0.002), (0.1, -0.05, 0.1)),
+                        ((0.0, 0.0), (2.0, 1.0, -0.5))):
         xi0 = _flat(x, k, mode, which, (0, 0), attach=1, y=x[0])["xi0"] + dxi0
-        a, b = _flat(x, k, mode, which, xi0), _flat(y, k, mode, which, xi0)
+        a, b = _flat(x, k, mode, which, xi0, lam_t=lam_t), _flat(y, k, mode, which, xi0, lam_t=lam_t)
         assert a["slipping"] == b["slipping"] and b["p"] == pytest.approx(a["p"], rel=1e-12)
         assert np.abs(b["f"].reshape(-1, 3) - a["f"].reshape(-1, 3) @ Rm.T).max() < 1e-12 * np.abs(a["f"]).max()
-        assert np.abs(b["t"] - Rm @ a["t"]).max() < 1e-12 * np.linalg.norm(a["t"])
+        # (a traction of 0.016 where λ_T and ε_T s nearly cancel: round-off of terms ~0.1)
+        assert np.abs(b["t"] - Rm @ a["t"]).max() < 1e-12 * max(np.linalg.norm(a["t"]), 0.1)
 
 
 @pytest.mark.parametrize("k", [3, 4])
@@ -142,16 +150,40 @@ def test_the_return_maps_stick_point_carries_the_traction(k, mode, which, slave)
     assert np.linalg.norm(np.cross(x[0] - r["t"] / EPS_T - point[0], r["n"])) < 1e-12
 
 
+@pytest.mark.parametrize("k", [3, 4])
+@pytest.mark.parametrize("mode, which, slave", CASES)
+def test_a_multiplier_on_the_convected_basis_carries_the_traction(k, mode, which, slave):
+    """The augmented Lagrangian's update of a slipping slave (attached under itself, λ_T = t as
+    components on the face's convected basis (a₁, a₂, a₁ × a₂) at the new stick point, with
+    :func:`face_bases`; at an edge or a vertex t is not in the face's plane): evaluated there,
+    the slave carries the same traction and force (1e-12), without elastic slip."""
+    x = np.vstack([slave, _face(k, np.random.default_rng(5))])
+    n = _flat(x, k, mode, which, (0, 0), attach=1, y=x[0])["n"]
+    w = np.cross(n, [0.3, 0.8, 0.5])
+    xi0 = _flat(x, k, mode, which, (0, 0), attach=1, y=x[0] + 0.3 * w / np.linalg.norm(w))["xi0"]
+    r = _flat(x, k, mode, which, xi0)
+    assert r["slipping"]
+    under = _flat(x, k, mode, which, (0, 0), attach=1, y=x[0])["xi0"]
+    faces = np.hstack([np.arange(k)[None, :], np.zeros((1, 4 - k), dtype=np.int64)]).astype(np.int64)
+    a1, a2 = np.zeros((1, 3)), np.zeros((1, 3))
+    k3.face_bases(x[1:], faces, np.array([k]), np.array([0]), under[None, :], a1, a2)
+    A = np.vstack([a1, a2, np.cross(a1, a2)])
+    lam_t = np.linalg.solve(A.T, r["t"])
+    back = _flat(x, k, mode, which, under, lam_t=lam_t)
+    assert np.abs(back["t"] - r["t"]).max() < 1e-12 * np.linalg.norm(r["t"])
+    assert np.abs(back["f"] - r["f"]).max() < 1e-12 * np.abs(r["f"]).max()
+
+
 # -- the smoothed master --------------------------------------------------------------------------
 def _smooth(x, k, rows, star, nstar, xi0, mu=0.3, cohesion=0.0, side=0.0, lam=0.0, tangent=False, attach=0,
-            y=None):
+            y=None, lam_t=(0.0, 0.0, 0.0)):
     m = 3 * len(x)
     f, K, t, n = np.zeros(m), np.zeros((m, m)), np.zeros(3), np.zeros(3)
     xi0 = np.array(xi0, float)
     y = np.zeros(3) if y is None else np.asarray(y, float)
     g, p, slipping = s3.node_to_smooth_face_friction(x, k, rows, star, nstar, side, 0.0 if not side else 0.2, lam,
-                                                     EPS, AREA, EPS_T, mu, cohesion, attach, y, xi0, tangent, f, K,
-                                                     t, n)
+                                                     EPS, AREA, EPS_T, mu, cohesion, attach, y, xi0,
+                                                     np.array(lam_t, float), tangent, f, K, t, n)
     return dict(g=g, p=p, slipping=slipping, f=f, K=K, t=t, n=n, xi0=xi0)
 
 
@@ -159,10 +191,12 @@ def _smooth(x, k, rows, star, nstar, xi0, mu=0.3, cohesion=0.0, side=0.0, lam=0.
 @pytest.mark.parametrize("where", ["inside", "near_edge"])
 @pytest.mark.parametrize("dxi0, cohesion, side", [((0.003, 0.002), 0.0, 0.0), ((0.15, -0.1), 0.0, 0.0),
                                                   ((0.1, 0.2), 0.5, 0.0), ((-0.15, 0.1), 0.0, 1.0)])
-def test_smoothed_master_tangent_in_stick_and_slip(quad, where, dxi0, cohesion, side):
+@pytest.mark.parametrize("lam_t", [(0.0, 0.0, 0.0), (0.3, -0.2, 0.2)])
+def test_smoothed_master_tangent_in_stick_and_slip(quad, where, dxi0, cohesion, side, lam_t):
     """On a shaken spherical cap's Nagata patches: K = ∂f/∂x over the slave and the stencil by
     central differences (1e-6); forces in balance; in slip |t| = c + μ p (1e-13), t ⟂ ν; a slave
-    attached where it is has no traction and the frictionless smoothed kernel's force (1e-13)."""
+    attached where it is has no traction and the frictionless smoothed kernel's force (1e-13);
+    with and without a tangential multiplier on the patch's basis at the stick point."""
     X, F = _cap(quad, seed=3)
     face = 4 if quad else 9
     ext, star, nstar = s3.build_stencils(X, F, np.radians(60.0))
@@ -181,17 +215,17 @@ def test_smoothed_master_tangent_in_stick_and_slip(quad, where, dxi0, cohesion, 
                            False, f0, K0)
     assert np.abs(base["f"] - f0).max() < 1e-13 * np.abs(f0).max()
     xi0 = base["xi0"] + dxi0
-    r = _smooth(x, k, rows, star[face], nstar[face], xi0, cohesion=cohesion, side=side, tangent=True)
+    r = _smooth(x, k, rows, star[face], nstar[face], xi0, cohesion=cohesion, side=side, tangent=True, lam_t=lam_t)
     assert r["slipping"] == (np.abs(dxi0).max() > 0.01) and r["p"] > 0.0
-    fd = _fd(lambda y: _smooth(y, k, rows, star[face], nstar[face], xi0, cohesion=cohesion, side=side)["f"][:m],
-             x[: 1 + rows])
+    fd = _fd(lambda y: _smooth(y, k, rows, star[face], nstar[face], xi0, cohesion=cohesion, side=side,
+                               lam_t=lam_t)["f"][:m], x[: 1 + rows])
     assert np.abs(r["K"][:m, :m] - fd).max() < 1e-6 * np.abs(r["K"]).max()
     assert np.abs(r["f"].reshape(-1, 3).sum(axis=0)).max() < 1e-13 * np.abs(r["f"]).max()
     assert abs(r["t"] @ r["n"]) < 1e-13 * EPS_T  # (round-off of s = r₀ − (r₀·n) n, |r₀| ~ 1)
     if r["slipping"]:
         assert np.linalg.norm(r["t"]) == pytest.approx(cohesion + 0.3 * r["p"], rel=1e-13)
     # the return map's stick point carries the traction (ε_T s = t)
-    if r["slipping"]:
+    if r["slipping"] and not any(lam_t):
         new = xi0[None, :].copy()
         s3.attach_on_patches(X, ext, np.array([k] * len(F)), star, nstar, np.array([face]),
                              (x[0] - r["t"] / EPS_T)[None, :], r["n"][None, :], new)

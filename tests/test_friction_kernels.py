@@ -24,10 +24,10 @@ def _stencil(seed: int = 0, R: float = 3.0):
     return np.concatenate([mid - 0.02 * n, nodes.ravel()])
 
 
-def _evaluate(x, xi0, lam=0.0, mu=0.3, cohesion=0.0, side=1.0, tangent=False):
+def _evaluate(x, xi0, lam=0.0, mu=0.3, cohesion=0.0, side=1.0, tangent=False, lam_t=0.0):
     one = np.ones(1)
     return node_to_smooth_segment_friction(x[None], side * one, 0.0 * one, lam * one, EPS * one, AREA * one,
-                                           EPS_T * one, mu * one, cohesion * one, xi0 * one, tangent)
+                                           EPS_T * one, mu * one, cohesion * one, xi0 * one, lam_t * one, tangent)
 
 
 def _fd(fun, x, h=1e-7):
@@ -58,22 +58,23 @@ def test_the_slip_gradient_is_the_derivative_of_the_slip(seed, dxi0):
 
 
 @pytest.mark.parametrize("seed", range(3))
-@pytest.mark.parametrize("lam", [0.0, 2.0])
-def test_in_stick_the_force_is_the_energy_gradient_and_the_tangent_its_symmetric_derivative(seed, lam):
+@pytest.mark.parametrize("lam, lam_t", [(0.0, 0.0), (2.0, 0.0), (2.0, -0.3)])
+def test_in_stick_the_force_is_the_energy_gradient_and_the_tangent_its_symmetric_derivative(seed, lam, lam_t):
     """A slave 0.004 (in ξ) from its stick point, μ large enough to stick: f = ∂W/∂x with
-    W = A⟨λ − εg⟩²/2ε + A ε_T s²/2 (1e-8), K = ∂f/∂x (1e-7 of its largest entry) and symmetric."""
+    W = A⟨λ − εg⟩²/2ε + A (λ_T s + ε_T s²/2) (1e-8), K = ∂f/∂x (1e-7 of its largest entry) and
+    symmetric; with and without a tangential multiplier λ_T."""
     x = _stencil(seed)
     xi = _evaluate(x, 0.0)[1][0]
     xi0 = xi - 0.004
 
     def energy(y):
-        g, _, p, t, s, _, _, _ = _evaluate(y, xi0, lam, mu=5.0)
-        return AREA * p[0] ** 2 / (2 * EPS) + AREA * EPS_T * s[0] ** 2 / 2
+        g, _, p, t, s, _, _, _ = _evaluate(y, xi0, lam, mu=5.0, lam_t=lam_t)
+        return AREA * p[0] ** 2 / (2 * EPS) + AREA * (lam_t * s[0] + EPS_T * s[0] ** 2 / 2)
 
-    g, _, p, t, s, slipping, f, K = _evaluate(x, xi0, lam, mu=5.0, tangent=True)
-    assert p[0] > 0.0 and not slipping[0] and t[0] == pytest.approx(EPS_T * s[0], rel=1e-14)
+    g, _, p, t, s, slipping, f, K = _evaluate(x, xi0, lam, mu=5.0, tangent=True, lam_t=lam_t)
+    assert p[0] > 0.0 and not slipping[0] and t[0] == pytest.approx(lam_t + EPS_T * s[0], rel=1e-14)
     assert np.abs(f[0] - _fd(energy, x)).max() < 1e-8 * np.abs(f[0]).max()
-    Kfd = _fd(lambda y: _evaluate(y, xi0, lam, mu=5.0)[6][0], x)
+    Kfd = _fd(lambda y: _evaluate(y, xi0, lam, mu=5.0, lam_t=lam_t)[6][0], x)
     assert np.abs(K[0] - Kfd).max() < 1e-7 * np.abs(K[0]).max()
     assert np.abs(K[0] - K[0].T).max() < 1e-10 * np.abs(K[0]).max()
 
@@ -81,16 +82,20 @@ def test_in_stick_the_force_is_the_energy_gradient_and_the_tangent_its_symmetric
 @pytest.mark.parametrize("seed", range(3))
 @pytest.mark.parametrize("cohesion", [0.0, 0.05])
 @pytest.mark.parametrize("direction", [1.0, -1.0])
-def test_in_slip_the_traction_is_coulombs_and_the_tangent_its_unsymmetric_derivative(seed, cohesion, direction):
+@pytest.mark.parametrize("lam_t", [0.0, 0.4])
+def test_in_slip_the_traction_is_coulombs_and_the_tangent_its_unsymmetric_derivative(seed, cohesion, direction,
+                                                                                     lam_t):
     """A slave 0.05 (in ξ) from its stick point, μ = 0.3: it slips, the traction is c + μ p against
-    the slip (1e-14), K = ∂f/∂x (1e-7) and not symmetric (the traction follows the pressure)."""
+    the slip (1e-14), K = ∂f/∂x (1e-7) and not symmetric (the traction follows the pressure). A
+    tangential multiplier λ_T (smaller than the slip's ε_T s) does not change the direction."""
     x = _stencil(seed)
     xi = _evaluate(x, 0.0)[1][0]
     xi0 = xi - direction * 0.05
-    g, _, p, t, s, slipping, f, K = _evaluate(x, xi0, 1.0, 0.3, cohesion, tangent=True)
-    assert slipping[0] and np.sign(s[0]) == direction
+    lam_t = -direction * lam_t  # against the slip: the return map still slips, along the slip
+    g, _, p, t, s, slipping, f, K = _evaluate(x, xi0, 1.0, 0.3, cohesion, tangent=True, lam_t=lam_t)
+    assert slipping[0] and np.sign(s[0]) == direction and abs(EPS_T * s[0]) > 2 * abs(lam_t)
     assert t[0] == pytest.approx(direction * (cohesion + 0.3 * p[0]), rel=1e-14)
-    Kfd = _fd(lambda y: _evaluate(y, xi0, 1.0, 0.3, cohesion)[6][0], x)
+    Kfd = _fd(lambda y: _evaluate(y, xi0, 1.0, 0.3, cohesion, lam_t=lam_t)[6][0], x)
     assert np.abs(K[0] - Kfd).max() < 1e-7 * np.abs(K[0]).max()
     assert np.abs(K[0] - K[0].T).max() > 1e-3 * np.abs(K[0]).max()
 

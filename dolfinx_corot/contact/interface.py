@@ -97,12 +97,17 @@ class Interface:
     BAND_USES = 3  # corrections per Newton solve that may count lifted pairs as closed
     SYMMETRIC_TANGENT = True
     STICK_SHAPE = ()  # a stick point's parameters on its master facet: ξ on a segment's curve
+    LAMBDA_SHAPE = ()  # a tangential multiplier: the traction along the curve's unit tangent
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = True, friction: Coulomb | None = None):
         if not isinstance(law, Penalty):
             raise TypeError(f"contact law must be dc.Penalty or dc.AugmentedLagrangian, got {type(law).__name__}")
         if friction is not None and not isinstance(friction, Coulomb):
             raise TypeError(f"contact friction must be dc.Coulomb(...) or None, got {type(friction).__name__}")
+        if friction is not None and friction.slip_tolerance is not None and not law.augmented:
+            raise ValueError(f"contact '{slaves[1]} -> {masters[1]}': Coulomb's slip_tolerance needs the augmented "
+                             f"Lagrangian normal law (law=dc.AugmentedLagrangian(...)), got {law!r}: its Uzawa updates "
+                             "augment the shear")
         self.friction = friction
         if slaves[0].model is masters[0].model and slaves[1] == masters[1]:
             raise ContactError(f"contact of surface '{slaves[1]}' with itself is not supported: give two "
@@ -154,14 +159,22 @@ class Interface:
         # converged state, the same on every rank
         self.stick_segment = np.full(len(self.area), -1)
         self.stick_xi = np.zeros((len(self.area),) + self.STICK_SHAPE)
+        # and the tangential multiplier λ_T (the augmented Lagrangian's, and the traction a slipping
+        # slave carries, attached under itself): in 2D the traction along the master curve's unit
+        # tangent, in 3D its components on the master face's convected basis (a₁, a₂, a₁ × a₂) at
+        # the stick point (which turns with the face)
+        self.stick_lambda = np.zeros((len(self.area),) + self.LAMBDA_SHAPE)
         # within a step: the stick points the step's evaluations use (a slave that touches, or
         # passes to another segment, gets its point at the first evaluation that needs it and keeps
         # it until the step converges, so that the step's tangent is the derivative of its forces)
         self.trial_segment = self.stick_segment.copy()
         self.trial_xi = self.stick_xi.copy()
+        self.trial_lambda = self.stick_lambda.copy()
         self._friction_trial = None
         if friction is not None:
             self.tangential_penalty = friction.tangential_factor * self.penalty
+        # the augmented Lagrangian's Uzawa updates act on the tangential traction as well
+        self.augment_friction = bool(law.augmented and friction is not None and friction.slip_tolerance is not None)
 
     @property
     def master_surface(self) -> str:
@@ -214,11 +227,13 @@ class Interface:
         points and the step's own (a line search's restore within a step keeps the step's)."""
         if self.friction is None:
             return None
-        return (self.stick_segment.copy(), self.stick_xi.copy(), self.trial_segment.copy(), self.trial_xi.copy())
+        return tuple(a.copy() for a in (self.stick_segment, self.stick_xi, self.stick_lambda, self.trial_segment,
+                                         self.trial_xi, self.trial_lambda))
 
     def restore_kept(self, state) -> None:
         if state is not None:
-            self.stick_segment, self.stick_xi, self.trial_segment, self.trial_xi = (a.copy() for a in state)
+            (self.stick_segment, self.stick_xi, self.stick_lambda, self.trial_segment, self.trial_xi,
+             self.trial_lambda) = (a.copy() for a in state)
 
     def kept_faces(self) -> np.ndarray | None:
         """Each slave's master facet of the last evaluation, if the search keeps it (3D)."""
@@ -231,6 +246,7 @@ class Interface:
         """A step (or its retry after a cut) starts from the converged stick points."""
         self.trial_segment = self.stick_segment.copy()
         self.trial_xi = self.stick_xi.copy()
+        self.trial_lambda = self.stick_lambda.copy()
 
     def note_step_start(self, converged: bool = False) -> None:
         """Keeps the slave and master positions of the last converged configuration (friction: a
@@ -241,29 +257,37 @@ class Interface:
             self.step_start = (self._positions(self.slave), self._positions(self.master))
 
     def commit(self) -> None:
-        """The step converged: each slave in contact keeps its stick point (sticking) or takes the
-        return map's (slipping: the point at the elastic distance t/ε_T behind it); a slave out of
-        contact has none."""
+        """The step converged: each slave in contact keeps its stick point and multiplier λ_T
+        (sticking) or is attached under itself (s = 0), its traction becoming its λ_T (slipping:
+        the next step starts on the slip surface, a reversal elastic); a slave out of contact has
+        none."""
         if self.friction is None:
             return
         seg = np.full(len(self.area), -1)
         xi0 = np.zeros(len(self.area))
+        lam0 = np.zeros(len(self.area))
         if self._friction_trial is not None:
-            s, m, x, xi, start, t, slipping, p = self._friction_trial
+            s, m, x, xi, start, t, slipping, p, lam_t = self._friction_trial
             for k in np.flatnonzero(p > 0.0):
                 seg[s[k]] = m[k]
-                xi0[s[k]] = (slipped_stick_point(x[k], xi[k], start[k], t[k], self.tangential_penalty) if slipping[k]
-                             else start[k])
-        self.commit_stick_points(seg, xi0)
+                if slipping[k]:
+                    xi0[s[k]] = slipped_stick_point(x[k], xi[k], start[k], 0.0, self.tangential_penalty)
+                    lam0[s[k]] = t[k]
+                else:
+                    xi0[s[k]], lam0[s[k]] = start[k], lam_t[k]
+        self.commit_stick_points(seg, xi0, lam0)
 
-    def commit_stick_points(self, seg: np.ndarray, xi0: np.ndarray) -> None:
-        """The converged stick points: each rank's own slaves' segments or faces seg (−1 elsewhere)
-        and parameters xi0 (zero elsewhere), combined over the ranks (the same on every rank); the
-        next step starts from them and from the converged positions."""
+    def commit_stick_points(self, seg: np.ndarray, xi0: np.ndarray, lam0: np.ndarray) -> None:
+        """The converged stick points: each rank's own slaves' segments or faces seg (−1 elsewhere),
+        parameters xi0 and tangential multipliers lam0 (zero elsewhere), combined over the ranks
+        (the same on every rank); the next step starts from them and from the converged
+        positions."""
         self.stick_segment = np.empty_like(seg)
         self.stick_xi = np.empty_like(xi0)
+        self.stick_lambda = np.empty_like(lam0)
         self.comm.Allreduce(seg, self.stick_segment, op=MPI.MAX)
         self.comm.Allreduce(xi0, self.stick_xi, op=MPI.SUM)
+        self.comm.Allreduce(lam0, self.stick_lambda, op=MPI.SUM)
         self.begin_step()
         self.note_step_start(converged=True)
 
@@ -298,6 +322,7 @@ class Interface:
         changed = new | (old != m)
         self.trial_segment[s[changed]] = m[changed]
         self.trial_xi[s[changed]] = xi0[changed]
+        self.trial_lambda[s[new]] = 0.0  # (a slave passing to the next segment keeps its traction)
         return xi0
 
     @property
@@ -557,12 +582,13 @@ class Interface:
                 j = i[closed]
                 xj = x[closed]
                 start = self._stick_parameters(xj, s[j], m[j], xm)
+                lam_t = self.trial_lambda[s[j]]
                 one = np.ones(len(j))
                 gj, xij, pj, tj, _, slipping, fj, Kj = node_to_smooth_segment_friction(
                     xj, sides[s[j]], offset[closed], lam[j], eps[j], self.area[s[j]], self.tangential_penalty * one,
-                    law.coefficient * one, law.cohesion * one, start, True)
+                    law.coefficient * one, law.cohesion * one, start, lam_t, True)
                 f[j], K[j] = fj, Kj
-                self._friction_trial = (s[j], m[j], xj, xij, start, tj, slipping, pj)
+                self._friction_trial = (s[j], m[j], xj, xij, start, tj, slipping, pj, lam_t)
         if (~on).any():
             normals = self._vertex_normals(xm)
             for k in (1, 2):
@@ -712,17 +738,25 @@ class Interface:
 
     def augment(self) -> bool:
         """Uzawa update λ ← ⟨λ − ε g⟩ if the largest |g| of the pairs in contact exceeds the
-        tolerance (all ranks agree); returns whether the multipliers changed."""
+        tolerance, or, with friction, the largest elastic slip of the sticking slaves exceeds its
+        own (all ranks agree); the tangential multipliers are updated with the normal ones (see
+        :meth:`augment_tangential`). Returns whether the multipliers changed."""
         if not self.law.augmented:
             return False
         s, g = self._last
         # in contact (p > 0) the gap should vanish: penetration, or an opening the pressure holds
         closed = self.multiplier[s] - self.penalty * g > 0.0
         error = self.comm.allreduce(float(np.max(np.abs(g[closed]), initial=0.0)), op=MPI.MAX)
-        logger.debug("contact %s: largest |g| of closed pairs %.3e (tolerance %.3e), %d updates", self.name, error,
-                     self.law.gap_tolerance * self.h, self.uzawa_updates)
-        if error <= self.law.gap_tolerance * self.h or self.uzawa_updates >= self.law.max_updates:
+        slip_error = self.stick_slip() if self.augment_friction else 0.0
+        logger.debug("contact %s: largest |g| of closed pairs %.3e (tolerance %.3e), largest elastic slip in "
+                     "stick %.3e, %d updates", self.name, error, self.law.gap_tolerance * self.h, slip_error,
+                     self.uzawa_updates)
+        if self.uzawa_updates >= self.law.max_updates or (
+                error <= self.law.gap_tolerance * self.h and
+                (not self.augment_friction or slip_error <= self.friction.slip_tolerance * self.h)):
             return False
+        if self.augment_friction:
+            self.augment_tangential()
         new = np.zeros_like(self.multiplier)
         new[s] = np.maximum(0.0, self.multiplier[s] - self.penalty * g)
         lam = np.zeros_like(new)
@@ -730,6 +764,28 @@ class Interface:
         self.multiplier[:] = lam
         self.uzawa_updates += 1
         return True
+
+    def stick_slip(self) -> float:
+        """The largest elastic slip |s| = |t − λ_T|/ε_T of the sticking slaves at the last
+        evaluation (all ranks); what the tangential Uzawa updates drive to zero."""
+        worst = 0.0
+        if self._friction_trial is not None:
+            s, m, x, xi, start, t, slipping, p, lam_t = self._friction_trial
+            stick = ~slipping & (p > 0.0)
+            worst = float(np.max(np.abs(t[stick] - lam_t[stick]), initial=0.0)) / self.tangential_penalty
+        return self.comm.allreduce(worst, op=MPI.MAX)
+
+    def augment_tangential(self) -> None:
+        """Uzawa update of the tangential multipliers (Simo & Laursen 1992, the augmented
+        Lagrangian of Coulomb friction): λ_T ← t at every sticking slave, which keeps its stick
+        point, so that the next solve draws it back to the point: its elastic slip, the penalty's
+        error, goes to zero while λ_T takes the traction. A slipping slave's traction is c + μp
+        whatever λ_T: it keeps both."""
+        if self._friction_trial is None:
+            return
+        s, m, x, xi, start, t, slipping, p, lam_t = self._friction_trial
+        stick = ~slipping & (p > 0.0)
+        self.trial_lambda[s[stick]] = t[stick]
 
     def pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Coordinates (n, gdim) and contact pressure (n,) of all slave nodes of this pass, on every
@@ -771,7 +827,7 @@ class Interface:
 
     def _friction_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(slaves, tractions, slipping) of the closed pairs at the last evaluation, this rank's."""
-        s, m, x, xi, start, t, slipping, p = self._friction_trial
+        s, m, x, xi, start, t, slipping, p, lam_t = self._friction_trial
         return s, t, slipping
 
     @property
@@ -991,6 +1047,7 @@ class Contact(Contribution):
             if itf.friction is not None:  # the stick points (the same on every rank)
                 out[f"{k}_stick_segment"] = itf.stick_segment.astype(float)
                 out[f"{k}_stick_xi"] = itf.stick_xi.copy()
+                out[f"{k}_stick_lambda"] = itf.stick_lambda.copy()
             if kept is not None:  # each rank's own slaves' faces
                 mine = np.full(len(kept), -1, dtype=np.int64)
                 mine[itf.mine] = kept[itf.mine]
@@ -1019,6 +1076,8 @@ class Contact(Contribution):
             if f"{k}_stick_segment" in arrays:
                 itf.stick_segment[:] = arrays[f"{k}_stick_segment"].astype(np.int64)
                 itf.stick_xi[:] = arrays[f"{k}_stick_xi"].reshape(itf.stick_xi.shape)
+                if f"{k}_stick_lambda" in arrays:  # (a checkpoint written before the tangential multipliers: zero)
+                    itf.stick_lambda[:] = arrays[f"{k}_stick_lambda"].reshape(itf.stick_lambda.shape)
                 itf.begin_step()
                 itf.step_start = None  # (taken when the next step starts, from the restored state)
             if f"{k}_anchor_slave" in arrays:

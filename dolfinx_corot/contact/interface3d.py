@@ -81,6 +81,7 @@ class Interface3D(Interface):
     FREE_EDGE_TOLERANCE = 0.05  # a solid's slave beyond the surface's border: this far (× the face) still on it
     TOUCH_EVALUATIONS = 8  # evaluations of a Newton solve with the touch band's stiffness whatever the pairs
     STICK_SHAPE = (2,)  # a stick point's parameters (ξ₀, η₀) on its master face
+    LAMBDA_SHAPE = (3,)  # a tangential multiplier's components on the face's basis at the stick point
 
     def __init__(self, slaves, masters, law: Penalty, smooth: bool = False, friction: Coulomb | None = None):
         super().__init__(slaves, masters, law, smooth, friction)
@@ -349,6 +350,7 @@ class Interface3D(Interface):
         n = len(s)
         old = self.trial_segment[s]
         xi0 = self.trial_xi[s].copy()
+        lam_t = self.trial_lambda[s].copy()
         attach = (old != m).astype(np.int64)  # a slave that closes, or has passed to another face
         y = xs[s].copy()
         new = np.flatnonzero(old < 0)
@@ -362,9 +364,12 @@ class Interface3D(Interface):
                                        eta, dist, on)
             xi0[new, 0], xi0[new, 1] = xi, eta
             attach[new] = 0
+            lam_t[new] = 0.0
         moved = np.flatnonzero((old >= 0) & (old != m))
-        if len(moved):  # its stick point, where it is now on its old face
+        if len(moved):  # its stick point, where it is now on its old face, and its multiplier
             y[moved] = self._stick_points(xm, old[moved], xi0[moved])
+            carried = self._multiplier_vectors(xm, old[moved], xi0[moved], lam_t[moved],
+                                               np.full(len(moved), self.smooth))
         offset = self.slave_offset[s] + self.master_offset[m]
         eps = np.full(n, self.penalty)
         curved = (mode == 0) if self.smooth else np.zeros(n, dtype=bool)
@@ -380,14 +385,14 @@ class Interface3D(Interface):
             if self.smooth and k and curved[i[0]]:
                 smooth3d.pairs_to_smooth_faces_friction(
                     xs, xm, self.ext, self.nodes, self.star, self.nstar, *args, side[i], offset[i], lam[i], eps[i],
-                    self.area[s[i]], self.tangential_penalty, mu, c, attach, y[i], xii, True, gi, pi, si, ti, ni, fi,
-                    Ki, self.touch)
+                    self.area[s[i]], self.tangential_penalty, mu, c, attach, y[i], xii, lam_t[i], True, gi, pi, si,
+                    ti, ni, fi, Ki, self.touch)
             elif k:
                 ff, KK = np.zeros((k, PAIR_DOFS)), np.zeros((k, PAIR_DOFS, PAIR_DOFS))
                 kernels3d.pairs_to_faces_friction(
                     xs, xm, self.faces, self.nodes, *args, mode[i], which[i], side[i], offset[i], lam[i], eps[i],
-                    self.area[s[i]], self.tangential_penalty, mu, c, attach, y[i], xii, True, gi, pi, si, ti, ni, ff,
-                    KK, self.touch)
+                    self.area[s[i]], self.tangential_penalty, mu, c, attach, y[i], xii, lam_t[i], True, gi, pi, si,
+                    ti, ni, ff, KK, self.touch)
                 fi[:, :PAIR_DOFS], Ki[:, :PAIR_DOFS, :PAIR_DOFS] = ff, KK
             return out
 
@@ -395,6 +400,13 @@ class Interface3D(Interface):
         t, normal = np.zeros((n, 3)), np.zeros((n, 3))
         f, K = np.zeros((n, self.width)), np.zeros((n, self.width, self.width))
         mu, c = self.friction.coefficient, float(self.friction.cohesion)
+        if len(moved):  # attached on the new face first (the line along the normal through the old
+            # stick point), the multiplier then expressed on the new face's basis there
+            lam_t[moved] = 0.0
+            for i in (moved[~curved[moved]], moved[curved[moved]]):
+                xi0[i] = kernels(i, mu, c, attach[i], xi0[i])[5]
+            attach[moved] = 0
+            lam_t[moved] = self._multiplier_components(xm, m[moved], xi0[moved], carried, curved[moved])
         for i in (np.flatnonzero(~curved), np.flatnonzero(curved)):
             g[i], p[i], slipping[i], t[i], normal[i], xi0[i], f[i], K[i] = kernels(i, mu, c, attach[i], xi0[i])
         # a pressure below the touch band's (round-off at bodies that touch unloaded) has no
@@ -408,13 +420,78 @@ class Interface3D(Interface):
         changed = closed & (old != m)
         self.trial_segment[s[changed]] = m[changed]
         self.trial_xi[s[changed]] = xi0[changed]
+        self.trial_lambda[s[changed]] = lam_t[changed]
         self._friction_trial = (s[closed], m[closed], curved[closed], xi0[closed], slipping[closed], t[closed],
-                                normal[closed], xs[s[closed]])
+                                normal[closed], xs[s[closed]], lam_t[closed])
         return g, f, K
 
     def _friction_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        s, m, curved, xi, slipping, t, normal, x_s = self._friction_trial
+        s, m, curved, xi, slipping, t, normal, x_s, lam_t = self._friction_trial
         return s, t, slipping
+
+    def _bases(self, xm: np.ndarray, faces: np.ndarray, xi0: np.ndarray, curved: np.ndarray) -> np.ndarray:
+        """The convected bases (k, 3, 3) (rows a₁, a₂, a₁ × a₂) of faces (their patches where
+        ``curved``) at the parameters xi0 (k, 2)."""
+        k = len(faces)
+        a1, a2 = np.zeros((k, 3)), np.zeros((k, 3))
+        flat = np.flatnonzero(~curved)
+        if len(flat):
+            b1, b2 = np.zeros((len(flat), 3)), np.zeros((len(flat), 3))
+            kernels3d.face_bases(xm, self.faces, self.nodes, faces[flat], xi0[flat], b1, b2)
+            a1[flat], a2[flat] = b1, b2
+        on = np.flatnonzero(curved)
+        if len(on):
+            b1, b2 = np.zeros((len(on), 3)), np.zeros((len(on), 3))
+            smooth3d.patch_bases(xm, self.ext, self.nodes, self.star, self.nstar, faces[on], xi0[on], b1, b2)
+            a1[on], a2[on] = b1, b2
+        return np.stack([a1, a2, np.cross(a1, a2)], axis=1)
+
+    def _multiplier_vectors(self, xm, faces, xi0, lam_t, curved) -> np.ndarray:
+        """The multipliers (k, 3) of components lam_t (k, 3) on the bases of :meth:`_bases`."""
+        return np.einsum("ka,kad->kd", lam_t, self._bases(xm, faces, xi0, curved))
+
+    def _multiplier_components(self, xm, faces, xi0, vectors, curved) -> np.ndarray:
+        """The components (k, 3) of the vectors (k, 3) on the bases of :meth:`_bases`."""
+        if not len(faces):
+            return np.zeros((0, 3))
+        bases = np.transpose(self._bases(xm, faces, xi0, curved), (0, 2, 1))  # columns a₁, a₂, a₁ × a₂
+        return np.linalg.solve(bases, vectors[..., None])[..., 0]
+
+    def _slipped(self, xm, m, curved, xi, slipping, t, normal, x_s):
+        """The stick points (k, 2) and multipliers (k, 3) of closed pairs after a slip: a slipping
+        slave attached under itself (the line along the normal through it meets its face), the
+        multiplier its traction on the face's basis there (its components for every pair)."""
+        xi = xi.copy()
+        for on_patch in (False, True):
+            i = np.flatnonzero(slipping & (curved == on_patch))
+            if not len(i):
+                continue
+            new = xi[i].copy()
+            if on_patch:
+                smooth3d.attach_on_patches(xm, self.ext, self.nodes, self.star, self.nstar, m[i], x_s[i], normal[i],
+                                           new)
+            else:
+                kernels3d.attach_on_faces(xm, self.faces, self.nodes, m[i], x_s[i], normal[i], new)
+            xi[i] = new
+        return xi, self._multiplier_components(xm, m, xi, t, curved)
+
+    def stick_slip(self) -> float:
+        worst = 0.0
+        if self._friction_trial is not None:
+            s, m, curved, xi, slipping, t, normal, x_s, lam_t = self._friction_trial
+            i = np.flatnonzero(~slipping)
+            if len(i):
+                v = self._multiplier_vectors(self._x[1], m[i], xi[i], lam_t[i], curved[i])
+                v -= np.einsum("kd,kd->k", v, normal[i])[:, None] * normal[i]  # (in the tangent plane)
+                worst = float(np.linalg.norm(t[i] - v, axis=1).max()) / self.tangential_penalty
+        return self.comm.allreduce(worst, op=MPI.MAX)
+
+    def augment_tangential(self) -> None:
+        if self._friction_trial is None:
+            return
+        s, m, curved, xi, slipping, t, normal, x_s, lam_t = self._friction_trial
+        i = np.flatnonzero(~slipping)  # (see Interface.augment_tangential)
+        self.trial_lambda[s[i]] = self._multiplier_components(self._x[1], m[i], xi[i], t[i], curved[i])
 
     def _stick_points(self, xm: np.ndarray, faces: np.ndarray, xi0: np.ndarray) -> np.ndarray:
         """The current positions (k, 3) of the stick points (ξ₀, η₀) on faces: of the flat faces, or
@@ -427,33 +504,22 @@ class Interface3D(Interface):
         return out
 
     def commit(self) -> None:
-        """The step converged: each slave in contact keeps its stick point (sticking) or takes the
-        return map's: the point of its face on the line through x_s − t/ε_T along the normal, at
-        which the elastic slip is the traction over ε_T (slipping); a slave out of contact has
+        """The step converged: each slave in contact keeps its stick point and multiplier
+        (sticking) or is attached under itself, its traction becoming its multiplier (slipping:
+        the next step starts on the cone's rim, a reversal elastic); a slave out of contact has
         none. The same on every rank."""
         if self.friction is None:
             return
         seg = np.full(len(self.area), -1)
         xi0 = np.zeros((len(self.area), 2))
+        lam0 = np.zeros((len(self.area), 3))
         if self._friction_trial is not None:
-            s, m, curved, xi, slipping, t, normal, x_s = self._friction_trial
-            xi = xi.copy()
-            xm = self._x[1]
-            for on_patch in (False, True):
-                i = np.flatnonzero(slipping & (curved == on_patch))
-                if not len(i):
-                    continue
-                y = x_s[i] - t[i] / self.tangential_penalty
-                new = xi[i].copy()
-                if on_patch:
-                    smooth3d.attach_on_patches(xm, self.ext, self.nodes, self.star, self.nstar, m[i], y, normal[i],
-                                               new)
-                else:
-                    kernels3d.attach_on_faces(xm, self.faces, self.nodes, m[i], y, normal[i], new)
-                xi[i] = new
+            s, m, curved, xi, slipping, t, normal, x_s, lam_t = self._friction_trial
+            new_xi, new_lam = self._slipped(self._x[1], m, curved, xi, slipping, t, normal, x_s)
             seg[s] = m
-            xi0[s] = xi
-        self.commit_stick_points(seg, xi0)
+            xi0[s] = np.where(slipping[:, None], new_xi, xi)
+            lam0[s] = np.where(slipping[:, None], new_lam, lam_t)
+        self.commit_stick_points(seg, xi0, lam0)
 
     def _idle(self, width: int):
         """No candidate pair on any rank: no pair, no force, no tangent (blocks of ``width`` dofs)."""

@@ -421,7 +421,7 @@ def slip(x, xi, xi0, out):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _friction_force(x, xi, side, offset, lam, eps, area, eps_t, mu, cohesion, xi0, f):
+def _friction_force(x, xi, side, offset, lam, eps, area, eps_t, mu, cohesion, xi0, lam_t, f):
     """Gap, pressure, traction, slip and force f (10,) of one pair at the closest point ξ (the
     module's law); returns (g, p, t, s, slipping)."""
     N = np.empty(10, dtype=x.dtype)
@@ -433,7 +433,7 @@ def _friction_force(x, xi, side, offset, lam, eps, area, eps_t, mu, cohesion, xi
             f[r] = 0.0
         return g, 0.0 * p, 0.0 * p, 0.0 * p, False
     s = slip(x, xi, xi0, S)
-    t = eps_t * s
+    t = lam_t + eps_t * s
     cap = cohesion + mu * p
     slipping = abs(t.real) > cap.real
     if slipping:
@@ -444,7 +444,7 @@ def _friction_force(x, xi, side, offset, lam, eps, area, eps_t, mu, cohesion, xi
 
 
 @numba.njit(cache=True, error_model="numpy")
-def node_to_smooth_segment_friction(x, side, offset, multiplier, penalty, area, eps_t, mu, cohesion, xi0,
+def node_to_smooth_segment_friction(x, side, offset, multiplier, penalty, area, eps_t, mu, cohesion, xi0, lam_t,
                                     with_tangent):
     r"""Frictional contact of k slaves on the segments of the C¹ master curve: Coulomb's law with
     cohesion.
@@ -455,11 +455,12 @@ def node_to_smooth_segment_friction(x, side, offset, multiplier, penalty, area, 
     nodes. The elastic slip is the distance from X₀ to the slave along the unit tangent
     τ = x'/|x'| at the contact point, s = (x_s − X₀)·τ(ξ) (:func:`slip`): a function of relative
     positions only, so rigid motions of the pair change neither s nor the traction (frame
-    indifference). The tangential traction (force per tributary length A) is the elastic
-    predictor ε_T s returned onto Coulomb's slip surface |t| ≤ c + μ p (c the cohesion,
-    μ = tan φ): t = ε_T s in stick (|ε_T s| ≤ c + μ p), t = (c + μ p) sign(s) in slip. The pair's
-    internal force is f = −A p ∂g/∂x + A t ∂s/∂x: in stick the gradient of the energy
-    A⟨λ − εg⟩²/2ε + A ε_T s²/2 (a symmetric tangent); in slip the traction follows the pressure
+    indifference). The tangential traction (force per tributary length A, along τ) is the
+    predictor λ_T + ε_T s (λ_T the augmented Lagrangian's tangential multiplier, held within a
+    Newton solve; zero: the penalty law) returned onto Coulomb's slip surface |t| ≤ c + μ p (c the
+    cohesion, μ = tan φ): t = λ_T + ε_T s in stick (|λ_T + ε_T s| ≤ c + μ p), t = (c + μ p) sign(λ_T +
+    ε_T s) in slip. The pair's internal force is f = −A p ∂g/∂x + A t ∂s/∂x: in stick the gradient
+    of the energy A⟨λ − εg⟩²/2ε + A (λ_T s + ε_T s²/2) (a symmetric tangent); in slip the traction follows the pressure
     and the tangent is not symmetric. Both parts are gradients of rotation-invariant scalars
     weighted by scalars, so the pair conserves linear and angular momentum. The return map moves
     the stick point at convergence (:func:`slipped_stick_point`). K = ∂f/∂x is the complex-step
@@ -470,8 +471,8 @@ def node_to_smooth_segment_friction(x, side, offset, multiplier, penalty, area, 
     tangential kinematics.)
 
     x: (k, 10) current positions (x_s, x_p, x_a, x_b, x_q); side, offset, multiplier λ, penalty ε,
-    area A, tangential penalty ε_T, friction coefficient μ, cohesion c and stick points ξ₀ (on each
-    pair's segment curve): (k,). Returns g, ξ, p, t, s: (k,) (g inf where no closest point was
+    area A, tangential penalty ε_T, friction coefficient μ, cohesion c, stick points ξ₀ (on each
+    pair's segment curve) and tangential multipliers λ_T: (k,). Returns g, ξ, p, t, s: (k,) (g inf where no closest point was
     found; p, t zero for open pairs), slipping (k,) bool, f (k, 10), K (k, 10, 10)."""
     k = x.shape[0]
     g = np.empty(k)
@@ -492,7 +493,7 @@ def node_to_smooth_segment_friction(x, side, offset, multiplier, penalty, area, 
             continue
         g[i], p[i], t[i], s[i], slipping[i] = _friction_force(x[i], xii, side[i], offset[i], multiplier[i],
                                                               penalty[i], area[i], eps_t[i], mu[i], cohesion[i],
-                                                              xi0[i], f[i])
+                                                              xi0[i], lam_t[i], f[i])
         if not with_tangent or p[i] <= 0.0:
             continue
         for c in range(10):
@@ -501,7 +502,7 @@ def node_to_smooth_segment_friction(x, side, offset, multiplier, penalty, area, 
             xc[c] += 1j * _H
             xic, _ = _closest_on_curve(xc, xii + 0j, 3)
             _friction_force(xc, xic, side[i], offset[i], multiplier[i] + 0j, penalty[i], area[i], eps_t[i],
-                            mu[i], cohesion[i], xi0[i], fc)
+                            mu[i], cohesion[i], xi0[i], lam_t[i] + 0j, fc)
             for r in range(10):
                 K[i, r, c] = fc[r].imag / _H
     return g, xi, p, t, s, slipping, f, K

@@ -481,15 +481,27 @@ def tangent_step(a1, a2, e, n, xi, eta):
 
 
 @numba.njit(cache=True)
-def coulomb_traction(xs, X0, n, p, eps_t, mu, cohesion, t):
+def convected(a1, a2, c, out):
+    """The vector out = c₁ a₁ + c₂ a₂ + c₃ a₁ × a₂ (3,) of components c (3,) on the convected basis
+    (a₁, a₂, a₁ × a₂) of a face (a_α = ∂X/∂ξ^α): a vector that turns and stretches with the face
+    (the normal's share: at an edge or vertex the contact normal is not the face's); real or
+    complex."""
+    for d in range(3):
+        e, f = (d + 1) % 3, (d + 2) % 3
+        out[d] = c[0] * a1[d] + c[1] * a2[d] + c[2] * (a1[e] * a2[f] - a1[f] * a2[e])
+
+
+@numba.njit(cache=True)
+def coulomb_traction(xs, X0, n, p, eps_t, mu, cohesion, lt, t):
     """Coulomb's traction t (3,) of a slave at xs attached to the stick point X0, contact normal n,
-    pressure p: the elastic slip s = (I − n nᵀ)(xs − X0), the predictor ε_T s returned radially
-    onto the cone |t| ≤ c + μ p. Real or complex (decided on the real
-    parts); returns whether the slave slips."""
+    pressure p, tangential multiplier lt (3,): the predictor (I − n nᵀ)(lt + ε_T (xs − X0)) (the
+    multiplier and the elastic slip in the tangent plane) returned radially onto the cone
+    |t| ≤ c + μ p. Real or complex (decided on the real parts); returns whether the slave
+    slips."""
     s = np.empty(3, dtype=t.dtype)
     rn = xs[0] * 0.0
     for d in range(3):
-        s[d] = xs[d] - X0[d]
+        s[d] = lt[d] + eps_t * (xs[d] - X0[d])
         rn += s[d] * n[d]
     ss = rn * 0.0
     for d in range(3):
@@ -497,16 +509,17 @@ def coulomb_traction(xs, X0, n, p, eps_t, mu, cohesion, t):
         ss += s[d] * s[d]
     norm = np.sqrt(ss)
     cap = cohesion + mu * p
-    slipping = eps_t * norm.real > cap.real
+    slipping = norm.real > cap.real
     for d in range(3):
-        t[d] = cap * s[d] / norm if slipping else eps_t * s[d]
+        t[d] = cap * s[d] / norm if slipping else s[d]
     return slipping
 
 
 @numba.njit(cache=True)
-def _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, cohesion, xi0, eta0, f, t, n):
+def _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, cohesion, xi0, eta0, lam_t, f, t, n):
     """Gap, pressure and slip state of one frictional pair with its force f (3 (1 + k),), traction
-    t (3,) and contact normal n (3,) (the module's friction law); returns (g, p, slipping)."""
+    t (3,) and contact normal n (3,) (the module's friction law; lam_t (3,) the tangential
+    multiplier's components on the face's basis at the stick point); returns (g, p, slipping)."""
     dt = x.dtype
     zero = x[0, 0] * 0.0
     N = np.empty(k, dtype=dt)
@@ -522,10 +535,16 @@ def _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, 
     dN0 = np.empty((k, 2))
     shape(k, xi0, eta0, N0, dN0)
     X0 = np.zeros(3, dtype=dt)
+    a1 = np.zeros(3, dtype=dt)
+    a2 = np.zeros(3, dtype=dt)
     for d in range(3):
         for a in range(k):
             X0[d] += N0[a] * x[1 + a, d]
-    slipping = coulomb_traction(x[0], X0, n, p, eps_t, mu, cohesion, t)
+            a1[d] += dN0[a, 0] * x[1 + a, d]
+            a2[d] += dN0[a, 1] * x[1 + a, d]
+    lt = np.empty(3, dtype=dt)
+    convected(a1, a2, lam_t, lt)
+    slipping = coulomb_traction(x[0], X0, n, p, eps_t, mu, cohesion, lt, t)
     for d in range(3):
         f[d] = -area * p * n[d] + area * t[d]
         for a in range(k):
@@ -535,7 +554,7 @@ def _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, 
 
 @numba.njit(cache=True)
 def node_to_face_friction(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, cohesion, attach, y, xi0,
-                          tangent, f, K, t, n, touch=0.0):
+                          lam_t, tangent, f, K, t, n, touch=0.0):
     r"""Frictional contact of one slave x[0] with a face (nodes x[1 … k]) in ``mode`` at ``which``
     on ``side`` (as :func:`node_to_face`): Coulomb's law with cohesion.
 
@@ -547,8 +566,12 @@ def node_to_face_friction(x, k, mode, which, side, offset, lam, eps, area, eps_t
     (I − n nᵀ)(x_c − X₀): the chord from the stick point to the contact point, in the plane of
     the face (exactly that chord on a flat face). It depends on relative positions only: rigid
     motions rotate it with the pair (frame indifference). The traction (force per tributary
-    area A) is the elastic predictor ε_T s returned onto Coulomb's cone |t| ≤ c + μ p: t = ε_T s
-    in stick, t = (c + μ p) s/|s| in slip (radial return). It acts on the slave and, opposite,
+    area A) is the predictor t* = (I − n nᵀ)(λ_T + ε_T (x_s − X₀)) returned onto Coulomb's cone
+    |t| ≤ c + μ p: t = t* in stick, t = (c + μ p) t*/|t*| in slip (radial return).
+    λ_T is the augmented Lagrangian's tangential multiplier (zero: the penalty law), held within
+    a Newton solve as its components ``lam_t`` (3,) on the face's convected basis at the stick
+    point (:func:`convected`), so that it turns with the face (frame indifference), its
+    variation in the tangent. It acts on the slave and, opposite,
     at the contact point of the face: f_s = A(−p n + t), f_a = A N_a (p n − t) (linear momentum
     conserved; the couple A (x_s − x_c) × t, of the order of the penetration times the traction,
     is that of the usual node-to-surface friction which leaves out the gap's share of the slip's
@@ -565,14 +588,14 @@ def node_to_face_friction(x, k, mode, which, side, offset, lam, eps, area, eps_t
     and out. Returns (g, p, slipping); t (3,) the traction, n (3,) the normal. An open pair: as
     :func:`node_to_face` (with its touch band), t zero."""
     g, p, slipping = _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, cohesion,
-                                     xi0[0], xi0[1], f, t, n)
+                                     xi0[0], xi0[1], lam_t, f, t, n)
     if p <= 0.0:
         g = node_to_face(x, k, mode, which, side, offset, lam, eps, area, tangent, f, K, touch)
         return g, 0.0, False
     if attach:  # from the face's centre
         xi0[0], xi0[1] = _attach(x, k, y, n, 1.0 / 3.0 if k == 3 else 0.0, 1.0 / 3.0 if k == 3 else 0.0)
         g, p, slipping = _friction_force(x, k, mode, which, side, offset, lam, eps, area, eps_t, mu, cohesion,
-                                         xi0[0], xi0[1], f, t, n)
+                                         xi0[0], xi0[1], lam_t, f, t, n)
     if tangent:
         m = 3 * (1 + k)
         xc = x.astype(np.complex128)
@@ -583,7 +606,7 @@ def node_to_face_friction(x, k, mode, which, side, offset, lam, eps, area, eps_t
             node, d = divmod(j, 3)
             xc[node, d] += 1j * H
             _friction_force(xc, k, mode, which, side, offset, lam + 0j, eps, area, eps_t, mu, cohesion,
-                            xi0[0], xi0[1], fc, tc, nc)
+                            xi0[0], xi0[1], lam_t, fc, tc, nc)
             xc[node, d] = x[node, d]
             for i in range(m):
                 K[i, j] = fc[i].imag / H
@@ -592,9 +615,9 @@ def node_to_face_friction(x, k, mode, which, side, offset, lam, eps, area, eps_t
 
 @numba.njit(cache=True)
 def pairs_to_faces_friction(xs, xm, faces, nodes, s, m, mode, which, side, offset, lam, eps, area, eps_t, mu,
-                            cohesion, attach, y, xi0, tangent, g, p, slipping, t, n, f, K, touch=0.0):
+                            cohesion, attach, y, xi0, lam_t, tangent, g, p, slipping, t, n, f, K, touch=0.0):
     """node_to_face_friction for pairs (slave s[i], face m[i]) as :func:`pairs_to_faces`; attach,
-    y (p, 3), xi0 (p, 2) (in and out), p, slipping, t (p, 3), n (p, 3) per pair."""
+    y (p, 3), xi0 (p, 2) (in and out), lam_t (p, 3), p, slipping, t (p, 3), n (p, 3) per pair."""
     for i in range(len(s)):
         k = nodes[m[i]]
         x = _face_pair(xs[s[i]], xm, faces, nodes, m[i])
@@ -602,7 +625,7 @@ def pairs_to_faces_friction(xs, xm, faces, nodes, s, m, mode, which, side, offse
         Ki = np.zeros((3 * (1 + k), 3 * (1 + k)))
         g[i], p[i], slipping[i] = node_to_face_friction(x, k, mode[i], which[i], side[i], offset[i], lam[i], eps[i],
                                                         area[i], eps_t, mu, cohesion, attach[i], y[i], xi0[i],
-                                                        tangent, fi, Ki, t[i], n[i], touch)
+                                                        lam_t[i], tangent, fi, Ki, t[i], n[i], touch)
         f[i, :] = 0.0
         K[i, :, :] = 0.0
         f[i, : 3 * (1 + k)] = fi
@@ -617,6 +640,22 @@ def attach_on_faces(xm, faces, nodes, m, y, n, xi0):
     for i in range(len(m)):
         x = _face_pair(y[i], xm, faces, nodes, m[i])
         xi0[i, 0], xi0[i, 1] = _attach(x, nodes[m[i]], y[i], n[i], xi0[i, 0], xi0[i, 1])
+
+
+@numba.njit(cache=True)
+def face_bases(xm, faces, nodes, m, xi0, a1, a2):
+    """The convected bases a_α = ∂X/∂ξ^α (p, 3) each of faces m (p,) at the parameters xi0 (p, 2)."""
+    for i in range(len(m)):
+        k = nodes[m[i]]
+        N = np.empty(k)
+        dN = np.empty((k, 2))
+        shape(k, xi0[i, 0], xi0[i, 1], N, dN)
+        for d in range(3):
+            a1[i, d] = 0.0
+            a2[i, d] = 0.0
+            for a in range(k):
+                a1[i, d] += dN[a, 0] * xm[faces[m[i], a], d]
+                a2[i, d] += dN[a, 1] * xm[faces[m[i], a], d]
 
 
 @numba.njit(cache=True)

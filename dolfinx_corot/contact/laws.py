@@ -59,12 +59,21 @@ class Coulomb:
     degrees (geotechnical users; give one of the two) and ``cohesion`` c a stress (force per
     unit area in 3D, per unit length in 2D, as the pressure). Below the bound the slave sticks
     through a tangential penalty ε_T = ``tangential_factor`` · ε (ε the normal penalty): it slips
-    elastically by τ/ε_T before it slides."""
+    elastically by τ/ε_T before it slides.
+
+    ``slip_tolerance`` (with an :class:`AugmentedLagrangian` normal law): the tangential
+    traction is augmented too (Simo & Laursen 1992). Each Uzawa update also sets every sticking
+    slave's tangential multiplier to its traction, λ_T ← t, the slave keeping its stick point,
+    until the elastic slip of every sticking slave is below ``slip_tolerance`` times the mean
+    master segment length: the stick is then exact to that tolerance, whatever ε_T. It costs
+    Newton solves (one per update) and, where slaves pass from stick to slip, iterations.
+    None (the default): the tangential penalty alone."""
 
     mu: float | None = None
     friction_angle: float | None = None
     cohesion: float = 0.0
     tangential_factor: float = 1.0
+    slip_tolerance: float | None = None
 
     def __post_init__(self):
         if (self.mu is None) == (self.friction_angle is None):
@@ -78,6 +87,7 @@ class Coulomb:
                 raise ValueError(f"Coulomb: friction_angle must be below 90 degrees, got {self.friction_angle}")
         validate.positive("Coulomb", "cohesion", self.cohesion, allow_zero=True)
         validate.positive("Coulomb", "tangential_factor", self.tangential_factor)
+        validate.positive("Coulomb", "slip_tolerance", self.slip_tolerance, allow_none=True)
 
     @property
     def coefficient(self) -> float:

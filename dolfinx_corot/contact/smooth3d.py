@@ -47,7 +47,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from .kernels3d import H, coulomb_traction, project, shape, tangent_step
+from .kernels3d import H, convected, coulomb_traction, project, shape, tangent_step
 
 _NEWTON_ITERATIONS = 30
 
@@ -471,11 +471,12 @@ def build_stencils(X: np.ndarray, facets: np.ndarray, sharp: float) -> tuple[np.
 
 # -- Coulomb friction on the smoothed master ---------------------------------------------------
 @numba.njit(cache=True)
-def _friction_force(x, k, star, nstar, side, offset, lam, eps, area, eps_t, mu, cohesion, xs0, es0, xi, eta, tt,
-                    f, t, n):
+def _friction_force(x, k, star, nstar, side, offset, lam, eps, area, eps_t, mu, cohesion, xs0, es0, lam_t, xi, eta,
+                    tt, f, t, n):
     """Gap, pressure and slip state of one frictional pair along the normal field, with its force
     f (3 (1 + W),), traction t (3,) and normal n = ν (3,), the stick point at (ξ₀, η₀) = (xs0, es0)
-    on the face's patch, the contact point sought from (ξ, η, tt); returns (g, p, slipping)."""
+    on the face's patch, the tangential multiplier's components lam_t (3,) on the patch's
+    convected basis there, the contact point sought from (ξ, η, tt); returns (g, p, slipping)."""
     dt = x.dtype
     nn = np.empty((k, 3), dtype=dt)
     N = np.empty(k, dtype=dt)
@@ -489,7 +490,9 @@ def _friction_force(x, k, star, nstar, side, offset, lam, eps, area, eps_t, mu, 
     t2 = np.empty(3, dtype=dt)
     zero = x[0, 0] * 0.0
     surface(x, k, nn, xs0 + zero, es0 + zero, X0, t1, t2)
-    slipping = coulomb_traction(x[0], X0, n, p, eps_t, mu, cohesion, t)
+    lt = np.empty(3, dtype=dt)
+    convected(t1, t2, lam_t, lt)
+    slipping = coulomb_traction(x[0], X0, n, p, eps_t, mu, cohesion, lt, t)
     for d in range(3):
         f[d] += area * t[d]
         for a in range(k):
@@ -517,14 +520,15 @@ def _attach_patch(x, k, nn, y, n, xi, eta):
 
 @numba.njit(cache=True)
 def node_to_smooth_face_friction(x, k, rows, star, nstar, side, offset, lam, eps, area, eps_t, mu, cohesion, attach,
-                                 y, xi0, tangent, f, K, t, n, touch=0.0):
+                                 y, xi0, lam_t, tangent, f, K, t, n, touch=0.0):
     """Frictional contact of a slave x[0] with a smoothed face: the normal part as
     :func:`node_to_smooth_face`, the tangential one as
     :func:`~dolfinx_corot.contact.kernels3d.node_to_face_friction` with the stick point on the
     face's Nagata patch, X₀ = x(ξ₀), the slip s = (I − ν νᵀ)(x_s − X₀) in the tangent plane of
     the normal field's ν, and the traction's reaction on the face nodes with the normal force's
-    weights. ``attach``, y, xi0 (2,) as there (the stick point where the line through y along ν
-    meets the patch). Returns (g, p, slipping)."""
+    weights. ``attach``, y, xi0 (2,), lam_t (3,) as there (the stick point where the line through
+    y along ν meets the patch; the multiplier's components on the patch's convected basis at the
+    stick point). Returns (g, p, slipping)."""
     nn = np.empty((k, 3))
     nodal_normals(x, k, star, nstar, nn)
     xi, eta, tt = start_point(x, k, nn)
@@ -535,14 +539,14 @@ def node_to_smooth_face_friction(x, k, rows, star, nstar, side, offset, lam, eps
     if not ok:
         return np.inf, 0.0, False
     g, p, slipping = _friction_force(x, k, star, nstar, side, offset, lam, eps, area, eps_t, mu, cohesion, xi0[0],
-                                     xi0[1], xi, eta, tt, f, t, n)
+                                     xi0[1], lam_t, xi, eta, tt, f, t, n)
     if p <= 0.0:
         g, _, _ = node_to_smooth_face(x, k, rows, star, nstar, side, offset, lam, eps, area, tangent, f, K, touch)
         return g, 0.0, False
     if attach:
         xi0[0], xi0[1] = _attach_patch(x, k, nn, y, n, xi, eta)
         g, p, slipping = _friction_force(x, k, star, nstar, side, offset, lam, eps, area, eps_t, mu, cohesion,
-                                         xi0[0], xi0[1], xi, eta, tt, f, t, n)
+                                         xi0[0], xi0[1], lam_t, xi, eta, tt, f, t, n)
     if tangent:
         m = 3 * (1 + rows)
         xc = x.astype(np.complex128)
@@ -553,7 +557,7 @@ def node_to_smooth_face_friction(x, k, rows, star, nstar, side, offset, lam, eps
             node, d = divmod(j, 3)
             xc[node, d] += 1j * H
             _friction_force(xc, k, star, nstar, side, offset, lam + 0j, eps, area, eps_t, mu, cohesion, xi0[0],
-                            xi0[1], xi, eta, tt, fc, tc, nc)
+                            xi0[1], lam_t, xi, eta, tt, fc, tc, nc)
             xc[node, d] = x[node, d]
             for i in range(m):
                 K[i, j] = fc[i].imag / H
@@ -562,16 +566,16 @@ def node_to_smooth_face_friction(x, k, rows, star, nstar, side, offset, lam, eps
 
 @numba.njit(cache=True)
 def pairs_to_smooth_faces_friction(xs, xm, ext, nodes, star, nstar, s, m, side, offset, lam, eps, area, eps_t, mu,
-                                   cohesion, attach, y, xi0, tangent, g, p, slipping, t, n, f, K, touch=0.0):
+                                   cohesion, attach, y, xi0, lam_t, tangent, g, p, slipping, t, n, f, K, touch=0.0):
     """node_to_smooth_face_friction for pairs (slave s[i], face m[i]) as :func:`pairs_to_smooth_faces`;
-    attach, y (p, 3), xi0 (p, 2) (in and out), p, slipping, t (p, 3), n (p, 3) per pair."""
+    attach, y (p, 3), xi0 (p, 2) (in and out), lam_t (p, 3), p, slipping, t (p, 3), n (p, 3) per pair."""
     W = ext.shape[1]
     x = np.empty((1 + W, 3))
     for i in range(len(s)):
         rows = _gather(xs, xm, ext, s[i], m[i], x)
         g[i], p[i], slipping[i] = node_to_smooth_face_friction(
             x, nodes[m[i]], rows, star[m[i]], nstar[m[i]], side[i], offset[i], lam[i], eps[i], area[i], eps_t, mu,
-            cohesion, attach[i], y[i], xi0[i], tangent, f[i], K[i], t[i], n[i], touch)
+            cohesion, attach[i], y[i], xi0[i], lam_t[i], tangent, f[i], K[i], t[i], n[i], touch)
 
 
 @numba.njit(cache=True)
@@ -595,6 +599,15 @@ def attach_on_patches(xm, ext, nodes, star, nstar, m, y, n, xi0):
     for i in range(len(m)):
         k, nn = _patch(y[i], xm, ext, nodes, star, nstar, m[i], x)
         xi0[i, 0], xi0[i, 1] = _attach_patch(x, k, nn, y[i], n[i], xi0[i, 0], xi0[i, 1])
+
+
+@numba.njit(cache=True)
+def patch_bases(xm, ext, nodes, star, nstar, m, xi0, a1, a2):
+    """The patches' bases a_α = ∂x/∂ξ^α (p, 3) each of faces m (p,) at the parameters xi0 (p, 2)."""
+    x = np.empty((1 + ext.shape[1], 3))
+    for i in range(len(m)):
+        k, nn = _patch(xm[ext[m[i], 0]], xm, ext, nodes, star, nstar, m[i], x)
+        surface(x, k, nn, xi0[i, 0], xi0[i, 1], np.empty(3), a1[i], a2[i])
 
 
 @numba.njit(cache=True)

@@ -125,20 +125,26 @@ def test_a_rigid_rotation_of_the_pair_rotates_its_forces(k, mode, which, slave):
         assert np.abs(b["t"] - Rm @ a["t"]).max() < 1e-12 * max(np.linalg.norm(a["t"]), 0.1)
 
 
-@pytest.mark.parametrize("k", [3, 4])
-@pytest.mark.parametrize("mode, which, slave", CASES)
-def test_the_return_maps_stick_point_carries_the_traction(k, mode, which, slave):
-    """After a slip the new stick point (the line along n through x_s − t/ε_T meets the face:
-    :func:`attach_on_faces`) gives the elastic slip ε_T s = t at the same configuration (1e-12):
-    the slave sits on the cone's rim, and a reversal starts elastic."""
+def _slipping_pair(k, mode, which, slave):
+    """(x, ξ₀, the kernel's result, the face as a one-face surface) of a slave that slips: its
+    stick point 0.3 from it in the tangent plane."""
     x = np.vstack([slave, _face(k, np.random.default_rng(5))])
     n = _flat(x, k, mode, which, (0, 0), attach=1, y=x[0])["n"]
     w = np.cross(n, [0.3, 0.8, 0.5])
     xi0 = _flat(x, k, mode, which, (0, 0), attach=1, y=x[0] + 0.3 * w / np.linalg.norm(w))["xi0"]
     r = _flat(x, k, mode, which, xi0)
     assert r["slipping"]
-    faces = np.arange(1, 1 + k)[None, :] - 1
-    faces = np.hstack([faces, np.zeros((1, 4 - k), dtype=np.int64)]).astype(np.int64)
+    faces = np.hstack([np.arange(k)[None, :], np.zeros((1, 4 - k), dtype=np.int64)]).astype(np.int64)
+    return x, xi0, r, faces
+
+
+@pytest.mark.parametrize("k", [3, 4])
+@pytest.mark.parametrize("mode, which, slave", CASES)
+def test_the_return_maps_stick_point_carries_the_traction(k, mode, which, slave):
+    """After a slip the new stick point (the line along n through x_s − t/ε_T meets the face:
+    :func:`attach_on_faces`) gives the elastic slip ε_T s = t at the same configuration (1e-12):
+    the slave sits on the cone's rim, and a reversal starts elastic."""
+    x, xi0, r, faces = _slipping_pair(k, mode, which, slave)
     new = xi0[None, :].copy()
     k3.attach_on_faces(x[1:], faces, np.array([k]), np.array([0]), (x[0] - r["t"] / EPS_T)[None, :],
                        r["n"][None, :], new)
@@ -155,18 +161,12 @@ def test_the_return_maps_stick_point_carries_the_traction(k, mode, which, slave)
 def test_a_multiplier_on_the_convected_basis_carries_the_traction(k, mode, which, slave):
     """The augmented Lagrangian's update of a slipping slave (attached under itself, λ_T = t as
     components on the face's convected basis (a₁, a₂, a₁ × a₂) at the new stick point, with
-    :func:`face_bases`; at an edge or a vertex t is not in the face's plane): evaluated there,
+    :func:`face_frames`; at an edge or a vertex t is not in the face's plane): evaluated there,
     the slave carries the same traction and force (1e-12), without elastic slip."""
-    x = np.vstack([slave, _face(k, np.random.default_rng(5))])
-    n = _flat(x, k, mode, which, (0, 0), attach=1, y=x[0])["n"]
-    w = np.cross(n, [0.3, 0.8, 0.5])
-    xi0 = _flat(x, k, mode, which, (0, 0), attach=1, y=x[0] + 0.3 * w / np.linalg.norm(w))["xi0"]
-    r = _flat(x, k, mode, which, xi0)
-    assert r["slipping"]
+    x, xi0, r, faces = _slipping_pair(k, mode, which, slave)
     under = _flat(x, k, mode, which, (0, 0), attach=1, y=x[0])["xi0"]
-    faces = np.hstack([np.arange(k)[None, :], np.zeros((1, 4 - k), dtype=np.int64)]).astype(np.int64)
     a1, a2 = np.zeros((1, 3)), np.zeros((1, 3))
-    k3.face_bases(x[1:], faces, np.array([k]), np.array([0]), under[None, :], a1, a2)
+    k3.face_frames(x[1:], faces, np.array([k]), np.array([0]), under[None, :], np.zeros((1, 3)), a1, a2)
     A = np.vstack([a1, a2, np.cross(a1, a2)])
     lam_t = np.linalg.solve(A.T, r["t"])
     back = _flat(x, k, mode, which, under, lam_t=lam_t)

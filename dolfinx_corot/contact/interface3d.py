@@ -437,12 +437,13 @@ class Interface3D(Interface):
         flat = np.flatnonzero(~curved)
         if len(flat):
             b1, b2 = np.zeros((len(flat), 3)), np.zeros((len(flat), 3))
-            kernels3d.face_bases(xm, self.faces, self.nodes, faces[flat], xi0[flat], b1, b2)
+            kernels3d.face_frames(xm, self.faces, self.nodes, faces[flat], xi0[flat], np.zeros_like(b1), b1, b2)
             a1[flat], a2[flat] = b1, b2
         on = np.flatnonzero(curved)
         if len(on):
             b1, b2 = np.zeros((len(on), 3)), np.zeros((len(on), 3))
-            smooth3d.patch_bases(xm, self.ext, self.nodes, self.star, self.nstar, faces[on], xi0[on], b1, b2)
+            smooth3d.patch_frames(xm, self.ext, self.nodes, self.star, self.nstar, faces[on], xi0[on], np.zeros_like(b1),
+                                  b1, b2)
             a1[on], a2[on] = b1, b2
         return np.stack([a1, a2, np.cross(a1, a2)], axis=1)
 

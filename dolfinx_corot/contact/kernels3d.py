@@ -643,30 +643,24 @@ def attach_on_faces(xm, faces, nodes, m, y, n, xi0):
 
 
 @numba.njit(cache=True)
-def face_bases(xm, faces, nodes, m, xi0, a1, a2):
-    """The convected bases a_α = ∂X/∂ξ^α (p, 3) each of faces m (p,) at the parameters xi0 (p, 2)."""
+def face_frames(xm, faces, nodes, m, xi0, out, a1, a2):
+    """The points Σ N_a(ξ₀) x_a (p, 3) of faces m (p,) at the parameters xi0 (p, 2) and their
+    convected bases a_α = ∂X/∂ξ^α (p, 3) each."""
     for i in range(len(m)):
         k = nodes[m[i]]
         N = np.empty(k)
         dN = np.empty((k, 2))
         shape(k, xi0[i, 0], xi0[i, 1], N, dN)
         for d in range(3):
-            a1[i, d] = 0.0
-            a2[i, d] = 0.0
+            out[i, d] = a1[i, d] = a2[i, d] = 0.0
             for a in range(k):
-                a1[i, d] += dN[a, 0] * xm[faces[m[i], a], d]
-                a2[i, d] += dN[a, 1] * xm[faces[m[i], a], d]
+                xa = xm[faces[m[i], a], d]
+                out[i, d] += N[a] * xa
+                a1[i, d] += dN[a, 0] * xa
+                a2[i, d] += dN[a, 1] * xa
 
 
 @numba.njit(cache=True)
 def face_points(xm, faces, nodes, m, xi0, out):
-    """The points Σ N_a(ξ₀) x_a (p, 3) of faces m (p,) at the parameters xi0 (p, 2)."""
-    for i in range(len(m)):
-        k = nodes[m[i]]
-        N = np.empty(k)
-        dN = np.empty((k, 2))
-        shape(k, xi0[i, 0], xi0[i, 1], N, dN)
-        for d in range(3):
-            out[i, d] = 0.0
-            for a in range(k):
-                out[i, d] += N[a] * xm[faces[m[i], a], d]
+    """The points of :func:`face_frames` alone."""
+    face_frames(xm, faces, nodes, m, xi0, out, np.empty_like(out), np.empty_like(out))

@@ -602,18 +602,16 @@ def attach_on_patches(xm, ext, nodes, star, nstar, m, y, n, xi0):
 
 
 @numba.njit(cache=True)
-def patch_bases(xm, ext, nodes, star, nstar, m, xi0, a1, a2):
-    """The patches' bases a_α = ∂x/∂ξ^α (p, 3) each of faces m (p,) at the parameters xi0 (p, 2)."""
+def patch_frames(xm, ext, nodes, star, nstar, m, xi0, out, a1, a2):
+    """The points x(ξ₀) (p, 3) of the patches of faces m (p,) at the parameters xi0 (p, 2) and
+    their bases a_α = ∂x/∂ξ^α (p, 3) each."""
     x = np.empty((1 + ext.shape[1], 3))
     for i in range(len(m)):
         k, nn = _patch(xm[ext[m[i], 0]], xm, ext, nodes, star, nstar, m[i], x)
-        surface(x, k, nn, xi0[i, 0], xi0[i, 1], np.empty(3), a1[i], a2[i])
+        surface(x, k, nn, xi0[i, 0], xi0[i, 1], out[i], a1[i], a2[i])
 
 
 @numba.njit(cache=True)
 def patch_points(xm, ext, nodes, star, nstar, m, xi0, out):
-    """The points x(ξ₀) (p, 3) of the patches of faces m (p,) at the parameters xi0 (p, 2)."""
-    x = np.empty((1 + ext.shape[1], 3))
-    for i in range(len(m)):
-        k, nn = _patch(xm[ext[m[i], 0]], xm, ext, nodes, star, nstar, m[i], x)
-        surface(x, k, nn, xi0[i, 0], xi0[i, 1], out[i], np.empty(3), np.empty(3))
+    """The points of :func:`patch_frames` alone."""
+    patch_frames(xm, ext, nodes, star, nstar, m, xi0, out, np.empty_like(out), np.empty_like(out))

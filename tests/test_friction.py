@@ -7,6 +7,7 @@ import pytest
 from mpi4py import MPI
 
 import dolfinx_corot as dc
+from dolfinx_corot.contact.kernels2d import curve_points, smooth_gap
 from dolfinx_corot.io.mesh import box, rectangles
 
 comm = MPI.COMM_WORLD
@@ -101,6 +102,58 @@ def test_friction_input_is_checked_by_name():
     solid = sc3.add_solid(box((1.0, 1.0, 1.0), (2, 2, 2), comm=comm), material=dc.Elastic(E, NU), degree=1)
     with pytest.raises(dc.ContactError, match="friction with the mortar discretization is not implemented"):
         sc3.contact((solid, "z1"), (solid, "z0"), friction=dc.Coulomb(mu=0.3), discretization="mortar")
+
+
+def test_a_stick_point_is_followed_along_the_master_as_a_material_point():
+    """A slave that passes to another segment carries its stick point along the master surface,
+    segment by segment, the parameter continued through each shared node at the curves' speed there:
+    on a straight surface of equal segments it is the same point (1e-12); on a curved surface of
+    unequal segments it is exact at the shared node, within 0.1 % of a segment a tenth of a segment
+    from it (measured 0.05 %: the extrapolated curve of the neighbour), and comes back to itself
+    after going up to four segments away and back (1e-12). A slave that comes into contact is attached where it faced the master at the step's
+    start: on the segment it then faced (the same point as projected directly onto that segment),
+    even when it ends the step on another."""
+    tm = rectangles({"a": (0.0, 0.0, 6.0, 1.0, 6, 1), "b": (0.0, 1.0, 1.0, 1.0, 1, 1)},
+                    {"a_top": [("a", "top")], "b_bottom": [("b", "bottom")]}, comm=comm)
+    sc = dc.Scene()
+    part = sc.add_solid(tm, material=dc.Elastic(E, NU), degree=1)
+    (itf,) = sc.contact((part, "b_bottom"), (part, "a_top"), friction=dc.Coulomb(mu=0.3))
+    X = itf.master.X
+    order = [int(np.flatnonzero(itf.neighbours[0] < 0)[0])]
+    while itf.neighbours[1][order[-1]] >= 0:
+        order.append(int(itf.neighbours[1][order[-1]]))
+    assert len(order) == 6
+    i, j = np.meshgrid(order, order, indexing="ij")
+    near = np.abs(np.subtract.outer(np.arange(6), np.arange(6))).ravel() <= 4
+    i, j = i.ravel()[near], j.ravel()[near]
+    xi = np.random.default_rng(1).uniform(0.0, 1.0, len(i))
+    ext = itf.ext
+
+    def points(xm, seg, t):
+        return curve_points(np.hstack([np.zeros((len(seg), 2))] + [xm[ext[seg, k]] for k in range(4)]), t)
+
+    turn = np.array([[np.cos(0.4), -np.sin(0.4)], [np.sin(0.4), np.cos(0.4)]])
+    straight = X @ turn.T
+    carried = itf._carried(i, xi, j, straight)
+    np.testing.assert_allclose(points(straight, j, carried), points(straight, i, xi), atol=1e-12)
+    theta = 0.9 * (X[:, 0] / 6.0) * (1.0 + 0.3 * X[:, 0] / 6.0)  # (segments 0.47–0.70 on an arc of radius 3)
+    arc = 3.0 * np.column_stack([np.sin(theta), np.cos(theta)])
+    a, b = np.array(order[:-1]), np.array(order[1:])
+    np.testing.assert_allclose(itf._carried(a, np.ones(5), b, arc), 0.0, atol=1e-15)
+    near_node = points(arc, b, itf._carried(a, np.full(5, 0.9), b, arc)) - points(arc, a, np.full(5, 0.9))
+    assert np.linalg.norm(near_node, axis=1).max() < 1e-3 * 0.47
+    there = itf._carried(i, xi, j, arc)
+    np.testing.assert_allclose(itf._carried(j, there, i, arc), xi, atol=1e-12)
+    # a point outside the arc, over the third segment: faced from the first and from the fifth
+    k = order[2]
+    over = points(arc, np.array([k]), np.array([0.3]))[0]
+    outward = over / np.linalg.norm(over)
+    xs = np.tile(over + 0.2 * outward, (2, 1))
+    seg, t = itf._faced(xs, np.array([order[0], order[4]]), arc)
+    _, direct, ok = smooth_gap(np.hstack([xs[:1]] + [arc[ext[k, m]][None, :] for m in range(4)]))
+    assert ok[0] and direct[0] == pytest.approx(0.3, abs=1e-2)
+    np.testing.assert_array_equal(seg, [k, k])
+    np.testing.assert_allclose(t, direct[0], atol=1e-12)
 
 
 class _Killed(Exception):

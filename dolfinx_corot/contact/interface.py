@@ -30,12 +30,14 @@ from __future__ import annotations
 
 import logging
 import time
+from typing import NamedTuple
+
 import numpy as np
 from mpi4py import MPI
 
 from ..assembly.contribution import Contribution
-from .kernels2d import (curve_points, node_to_smooth_segment, node_to_smooth_segment_friction, node_to_vertex,
-                        slipped_stick_point, smooth_gap)
+from .kernels2d import (node_to_smooth_segment, node_to_smooth_segment_friction, node_to_vertex,
+                        node_to_vertex_friction, slipped_stick_point, smooth_gap, vertex_stick_point)
 from .laws import ContactError, Coulomb, Penalty
 from .search import broad_phase, narrow_phase
 
@@ -84,6 +86,23 @@ def _smoothing_neighbours(X: np.ndarray, segments: np.ndarray, sharp: float) -> 
     ok[ok] &= np.einsum("ij,ij->i", t[ok], t[nxt[ok]]) >= np.cos(sharp)
     ext[ok, 3] = segments[nxt[ok], 1]
     return ext
+
+
+class FrictionTrial(NamedTuple):
+    """The closed pairs' friction at the last evaluation (this rank's): slaves s, segments m, the
+    stencils' positions x (k, 10), closest-point parameters xi, stick points start, tractions t,
+    slipping, pressures p, tangential multipliers lam_t, and which vertex of the segment a slave
+    at a sharp corner meets (1: a, 2: b; 0: on the segment)."""
+    s: np.ndarray
+    m: np.ndarray
+    x: np.ndarray
+    xi: np.ndarray
+    start: np.ndarray
+    t: np.ndarray
+    slipping: np.ndarray
+    p: np.ndarray
+    lam_t: np.ndarray
+    which: np.ndarray
 
 
 class Interface:
@@ -199,6 +218,13 @@ class Interface:
         self.valence = np.bincount(sm.ravel(), minlength=len(Xm))
         self.ext = (_smoothing_neighbours(Xm, sm, self.SMOOTH_ANGLE) if self.smooth
                     else np.column_stack([sm[:, 0], sm[:, 0], sm[:, 1], sm[:, 1]]))
+        # each segment's neighbours along the surface, before its node a and after its node b (−1: an end of
+        # the surface, or a node that more than two segments share)
+        into, out = np.full(len(Xm), -1), np.full(len(Xm), -1)
+        into[sm[:, 1]] = np.arange(len(sm))
+        out[sm[:, 0]] = np.arange(len(sm))
+        chain = self.valence == 2
+        self.neighbours = (np.where(chain[sm[:, 0]], into[sm[:, 0]], -1), np.where(chain[sm[:, 1]], out[sm[:, 1]], -1))
 
     # -- binding to a system ---------------------------------------------------------
     def bind(self, system) -> None:
@@ -267,14 +293,16 @@ class Interface:
         xi0 = np.zeros(len(self.area))
         lam0 = np.zeros(len(self.area))
         if self._friction_trial is not None:
-            s, m, x, xi, start, t, slipping, p, lam_t = self._friction_trial
-            for k in np.flatnonzero(p > 0.0):
-                seg[s[k]] = m[k]
-                if slipping[k]:
-                    xi0[s[k]] = slipped_stick_point(x[k], xi[k], start[k], 0.0, self.tangential_penalty)
-                    lam0[s[k]] = t[k]
+            tr = self._friction_trial
+            s = tr.s
+            for k in np.flatnonzero(tr.p > 0.0):
+                seg[s[k]] = tr.m[k]
+                if tr.slipping[k]:
+                    xi0[s[k]] = (vertex_stick_point(tr.x[k], tr.which[k], tr.start[k]) if tr.which[k] else
+                                 slipped_stick_point(tr.x[k], tr.xi[k], tr.start[k], 0.0, self.tangential_penalty))
+                    lam0[s[k]] = tr.t[k]
                 else:
-                    xi0[s[k]], lam0[s[k]] = start[k], lam_t[k]
+                    xi0[s[k]], lam0[s[k]] = tr.start[k], tr.lam_t[k]
         self.commit_stick_points(seg, xi0, lam0)
 
     def commit_stick_points(self, seg: np.ndarray, xi0: np.ndarray, lam0: np.ndarray) -> None:
@@ -294,36 +322,93 @@ class Interface:
     def _stick_parameters(self, x: np.ndarray, s: np.ndarray, m: np.ndarray, xm: np.ndarray) -> np.ndarray:
         """The parameters ξ₀ (n,) of the slaves' stick points on the curves of their segments m
         (pairs x (n, 10); master positions xm): the committed one on the same segment; a slave that
-        comes into contact is attached where it was at the step's start, projected onto the
-        segment's curve as it was then (a material point of the master, whatever path the iterates
-        take); one that has passed to another segment takes the closest point of that segment's
-        curve to its stick point (a constant of the step's tangent: its dependence on the old
-        segment's nodes is left out)."""
+        comes into contact is attached where it was at the step's start, projected onto the master
+        as it was then (the segment it then faced: a material point of the master, whatever path the
+        iterates take); one that has passed to another segment carries its stick point along the
+        surface (:meth:`_carried`). A constant of the step's tangent."""
         xi0 = self.trial_xi[s].copy()
         old = self.trial_segment[s]
-        _, now, _ = smooth_gap(x)
+        _, now, ok = smooth_gap(x)
+        a, b = x[:, 4:6], x[:, 6:8]  # (no closest point on the curve, a slave at a corner: the chord's, on it)
+        chord = np.einsum("ij,ij->i", x[:, :2] - a, b - a) / np.einsum("ij,ij->i", b - a, b - a)
+        now = np.where(ok, now, np.clip(chord, 0.0, 1.0))
         new = old < 0
         xi0[new] = now[new]
         if new.any() and self.step_start is not None:  # (None: evaluated outside a step)
             xs0, xm0 = self.step_start
-            ext = self.ext[m[new]]
-            _, then, ok = smooth_gap(np.hstack([xs0[s[new]]] + [xm0[ext[:, j]] for j in range(4)]))
-            xi0[new] = np.where(ok, then, now[new])
+            seg, then = self._faced(xs0[s[new]], m[new], xm0)
+            xi0[new] = np.where(seg >= 0, self._carried(seg, then, m[new], xm), now[new])
         moved = np.flatnonzero(~new & (old != m))
         if len(moved):
-            ext = self.ext[old[moved]]
-            y = np.hstack([np.zeros((len(moved), 2))] + [xm[ext[:, j]] for j in range(4)])
-            y[:, :2] = x[moved, :2]
-            point = curve_points(y, self.trial_xi[s[moved]])
-            z = x[moved].copy()
-            z[:, :2] = point
-            _, xi_t, ok = smooth_gap(z)
-            xi0[moved] = np.where(ok, xi_t, now[moved])
+            xi0[moved] = self._carried(old[moved], self.trial_xi[s[moved]], m[moved], xm)
+        xi0 = np.where(np.isnan(xi0), now, xi0)  # (not along the surface within reach: attached where it is)
         changed = new | (old != m)
         self.trial_segment[s[changed]] = m[changed]
         self.trial_xi[s[changed]] = xi0[changed]
         self.trial_lambda[s[new]] = 0.0  # (a slave passing to the next segment keeps its traction)
         return xi0
+
+    HOPS = 4  # how far along the surface (in segments) a stick point is followed
+
+    def _faced(self, xs: np.ndarray, seg: np.ndarray, xm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The segments and parameters ξ ∈ [0, 1] of the closest points of the points xs (n, 2) on the
+        master (positions xm), searched from the segments seg along the surface: a projection beyond an
+        end of a segment's curve passes to the neighbour there (a segment's extrapolated curve is no
+        material point of the master). Beyond a free end, the extrapolated parameter of the end segment;
+        segment −1 where no projection was found."""
+        seg, prev = seg.copy(), np.full(len(seg), -1)
+        xi = np.full(len(seg), np.nan)
+        todo = np.arange(len(seg))
+        for _ in range(self.HOPS + 1):
+            ext = self.ext[seg[todo]]
+            _, t, ok = smooth_gap(np.hstack([xs[todo]] + [xm[ext[:, j]] for j in range(4)]))
+            # (no projection on this curve: the side of the chord's projection tells the way on)
+            a, b = xm[ext[:, 1]], xm[ext[:, 2]]
+            way = np.where(ok, t, np.einsum("ij,ij->i", xs[todo] - a, b - a) / np.einsum("ij,ij->i", b - a, b - a))
+            nb = np.where(way > 1.0, self.neighbours[1][seg[todo]],
+                          np.where(way < 0.0, self.neighbours[0][seg[todo]], -1))
+            back = (nb >= 0) & (nb == prev[todo])  # (beyond the node that two segments share: that node)
+            xi[todo] = np.where(back, np.clip(way, 0.0, 1.0), t)
+            go = (nb >= 0) & ~back
+            seg[todo[~ok & ~go & ~back]] = -1
+            todo, nb = todo[go], nb[go]
+            prev[todo], seg[todo] = seg[todo], nb
+            if not len(todo):
+                break
+        seg[todo], xi[todo] = prev[todo], np.clip(xi[todo], 0.0, 1.0)  # (not settled within reach: the last end)
+        return seg, xi
+
+    def _carried(self, seg: np.ndarray, xi: np.ndarray, target: np.ndarray, xm: np.ndarray) -> np.ndarray:
+        """The parameters on the curves of the segments target (n,) of the points at ξ (n,) on the
+        segments seg: followed along the surface segment by segment (at most HOPS), the parameter
+        continued through each shared node at the rate of the curves' speeds |dx/dξ| there (positions
+        xm): first-order exact at the node (a C¹ curve has the same speed on both sides, the
+        continuation is ξ ∓ 1; a faceted one, the ratio of the lengths), and the same point when
+        carried back. NaN where target is not within reach."""
+        ext = self.ext
+        # the speeds at the ends of each segment's curve: (x_b − x_p)/2 at ξ = 0, (x_q − x_a)/2 at ξ = 1
+        speed = (np.linalg.norm(xm[ext[:, 2]] - xm[ext[:, 0]], axis=1),
+                 np.linalg.norm(xm[ext[:, 3]] - xm[ext[:, 1]], axis=1))
+        out = np.where(seg == target, xi, np.nan)
+        for forward in (False, True):
+            cur, t = seg.copy(), xi.copy()
+            for _ in range(self.HOPS):
+                live = np.flatnonzero((cur >= 0) & np.isnan(out))
+                if not len(live):
+                    break
+                a = cur[live]
+                b = self.neighbours[1 if forward else 0][a]
+                has = b >= 0
+                live, a, b = live[has], a[has], b[has]
+                cur[:] = -1
+                cur[live] = b
+                if forward:
+                    t[live] = (t[live] - 1.0) * speed[1][a] / speed[0][b]
+                else:
+                    t[live] = 1.0 + t[live] * speed[0][a] / speed[1][b]
+                hit = live[b == target[live]]
+                out[hit] = t[hit]
+        return out
 
     @property
     def slave_offset(self) -> np.ndarray:
@@ -567,6 +652,7 @@ class Interface:
         K[:] = 0.0
         normal[:] = 0.0
         self._friction_trial = None
+        law, trials = self.friction, []
         on = mode[s] == 0
         if on.any():
             i = np.flatnonzero(on)
@@ -575,10 +661,7 @@ class Interface:
             g[i], _, _, f[i], K[i], _, normal[i] = node_to_smooth_segment(x, sides[s[i]], offset, lam[i], eps[i],
                                                                           self.area[s[i]], True, touch)
             if self.friction is not None:  # the pairs with a pressure: Coulomb's law on the same curve
-                # (a pressure below the touch band's, the round-off of bodies that touch unloaded,
-                # has no friction: its cone, of that size, would turn the traction with the round-off)
-                law = self.friction
-                closed = np.flatnonzero(lam[i] - eps[i] * g[i] > self.penalty * self.touch)
+                closed = self._closed(lam[i], eps[i], g[i])
                 j = i[closed]
                 xj = x[closed]
                 start = self._stick_parameters(xj, s[j], m[j], xm)
@@ -588,7 +671,8 @@ class Interface:
                     xj, sides[s[j]], offset[closed], lam[j], eps[j], self.area[s[j]], self.tangential_penalty * one,
                     law.coefficient * one, law.cohesion * one, start, lam_t, True)
                 f[j], K[j] = fj, Kj
-                self._friction_trial = (s[j], m[j], xj, xij, start, tj, slipping, pj, lam_t)
+                trials.append(FrictionTrial(s[j], m[j], xj, xij, start, tj, slipping, pj, lam_t,
+                                            np.zeros(len(j), dtype=np.int64)))
         if (~on).any():
             normals = self._vertex_normals(xm)
             for k in (1, 2):
@@ -606,6 +690,28 @@ class Interface:
                 g[i] = gv
                 f[np.ix_(i, idx)] = fv
                 K[np.ix_(i, idx, idx)] = Kv
+                if self.friction is not None:  # Coulomb's law at the corner, the stick point on the segment
+                    closed = self._closed(lam[i], eps[i], gv)
+                    j = i[closed]
+                    xj = np.hstack([xs[s[j]]] + [xm[ext[j, c]] for c in range(4)])
+                    start = self._stick_parameters(xj, s[j], m[j], xm)
+                    lam_t = self.trial_lambda[s[j]]
+                    one = np.ones(len(j))
+                    which = np.full(len(j), k)
+                    _, pj, tj, _, slipping, fj, Kj = node_to_vertex_friction(
+                        xj, which, normal_v[closed], offset[closed], lam[j], eps[j], self.area[s[j]],
+                        self.tangential_penalty * one, law.coefficient * one, law.cohesion * one, start, lam_t, True)
+                    f[j], K[j] = fj, Kj
+                    trials.append(FrictionTrial(s[j], m[j], xj, np.full(len(j), k - 1.0), start, tj, slipping, pj,
+                                                lam_t, which))
+        if trials:
+            self._friction_trial = FrictionTrial(*(np.concatenate(parts) for parts in zip(*trials)))
+
+    def _closed(self, lam: np.ndarray, eps: np.ndarray, g: np.ndarray) -> np.ndarray:
+        """The pairs with friction: those with a pressure above the touch band's (the round-off of
+        bodies that touch unloaded has no friction: its cone, of that size, would turn the
+        traction with the round-off)."""
+        return np.flatnonzero(lam - eps * g > self.penalty * self.touch)
 
     def _assign(self, xs, xm, pairs):
         """(segment, mode, side), each (n_slaves,), of this rank's candidate pairs: mode 0 on the
@@ -645,6 +751,20 @@ class Interface:
             sharp = np.where(end == 0, self.ext[m, 0] == self.ext[m, 1], self.ext[m, 3] == self.ext[m, 2])
             close = np.linalg.norm(xs - xm[vertex], axis=1) - self.slave_offset - self.master_offset[m] < self.margin
             corner = (near >= 0) & ((t < 0.0) | (t > 1.0)) & (self.valence[vertex] >= 2) & sharp & close
+            # of the two segments at the vertex, the one whose normal is the closer to the slave's
+            # direction from it (what friction at the corner measures its slip along)
+            other = np.where(end == 0, self.neighbours[0][m], self.neighbours[1][m])
+            j = np.flatnonzero(corner & (other >= 0))
+            if len(j):
+                d = xs[j] - xm[vertex[j]]
+
+                def facing(k):
+                    chord = xm[seg[k, 1]] - xm[seg[k, 0]]
+                    return (d[:, 0] * chord[:, 1] - d[:, 1] * chord[:, 0]) / np.linalg.norm(chord, axis=1)
+
+                listed = np.isin(j * len(seg) + other[j], rest[:, 0] * len(seg) + rest[:, 1])  # (a candidate pair)
+                swap = j[(facing(other[j]) > facing(near[j])) & listed]
+                near[swap], end[swap] = other[swap], 1 - end[swap]
             segment[corner] = near[corner]
             mode[corner] = 1 + end[corner]
         return segment, mode, sides
@@ -770,9 +890,9 @@ class Interface:
         evaluation (all ranks); what the tangential Uzawa updates drive to zero."""
         worst = 0.0
         if self._friction_trial is not None:
-            s, m, x, xi, start, t, slipping, p, lam_t = self._friction_trial
-            stick = ~slipping & (p > 0.0)
-            worst = float(np.max(np.abs(t[stick] - lam_t[stick]), initial=0.0)) / self.tangential_penalty
+            tr = self._friction_trial
+            stick = ~tr.slipping & (tr.p > 0.0)
+            worst = float(np.max(np.abs(tr.t[stick] - tr.lam_t[stick]), initial=0.0)) / self.tangential_penalty
         return self.comm.allreduce(worst, op=MPI.MAX)
 
     def augment_tangential(self) -> None:
@@ -783,9 +903,9 @@ class Interface:
         whatever λ_T: it keeps both."""
         if self._friction_trial is None:
             return
-        s, m, x, xi, start, t, slipping, p, lam_t = self._friction_trial
-        stick = ~slipping & (p > 0.0)
-        self.trial_lambda[s[stick]] = t[stick]
+        tr = self._friction_trial
+        stick = ~tr.slipping & (tr.p > 0.0)
+        self.trial_lambda[tr.s[stick]] = tr.t[stick]
 
     def pressure(self, current: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Coordinates (n, gdim) and contact pressure (n,) of all slave nodes of this pass, on every
@@ -827,8 +947,8 @@ class Interface:
 
     def _friction_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(slaves, tractions, slipping) of the closed pairs at the last evaluation, this rank's."""
-        s, m, x, xi, start, t, slipping, p, lam_t = self._friction_trial
-        return s, t, slipping
+        tr = self._friction_trial
+        return tr.s, tr.t, tr.slipping
 
     @property
     def contact_forces(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -533,6 +533,125 @@ def slipped_stick_point(x, xi, xi0, t, eps_t):
 
 
 @numba.njit(cache=True, error_model="numpy")
+def _vertex_tangent(x, which):
+    """The unit tangent (τ_x, τ_y), the speed |x'| and the weights dφ/dξ of the segment's curve
+    at its vertex ``which`` (1: a, ξ = 0; 2: b, ξ = 1)."""
+    _, _, tx, ty, _, _, _, dw = _hermite(x, 0.0 * x[0] + (which - 1.0))
+    la = np.sqrt(tx * tx + ty * ty)
+    return tx / la, ty / la, la, dw
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _vertex_friction_force(x, which, nbx, nby, offset, lam, eps, area, eps_t, mu, cohesion, xi0, lam_t, f):
+    """Gap, pressure, traction, slip and force f (10,) of one slave at the vertex ``which`` (1: a,
+    2: b) of its segment (:func:`node_to_vertex_friction`); returns (g, p, t, s, slipping)."""
+    v = 2 + 2 * which
+    dx = x[0] - x[v]
+    dy = x[1] - x[v + 1]
+    dist = np.sqrt(dx * dx + dy * dy)
+    sg = 1.0 if (dx * nbx + dy * nby).real >= 0.0 else -1.0
+    g = sg * dist - offset
+    p = lam - eps * g
+    if p.real <= 0.0 or dist.real == 0.0:
+        for r in range(10):
+            f[r] = 0.0
+        return g, 0.0 * p, 0.0 * p, 0.0 * p, False
+    taux, tauy, la, dw = _vertex_tangent(x, which)
+    w0 = _hermite(x, xi0 + 0.0 * dist)[6]
+    r0x = x[0] - (w0[0] * x[2] + w0[1] * x[4] + w0[2] * x[6] + w0[3] * x[8])
+    r0y = x[1] - (w0[0] * x[3] + w0[1] * x[5] + w0[2] * x[7] + w0[3] * x[9])
+    s = r0x * taux + r0y * tauy
+    # δs = (δx_s − Σ φ_k(ξ₀) δx_k)·τ + (r₀·ν/|x'|) ν·Σ dφ_k δx_k, ν = (τ_y, −τ_x): τ turns with the nodes
+    q = (r0x * tauy - r0y * taux) / la
+    S = np.empty(10, dtype=x.dtype)
+    S[0] = taux
+    S[1] = tauy
+    for k in range(4):
+        S[2 + 2 * k] = -w0[k] * taux + q * dw[k] * tauy
+        S[3 + 2 * k] = -w0[k] * tauy - q * dw[k] * taux
+    t = lam_t + eps_t * s
+    cap = cohesion + mu * p
+    slipping = abs(t.real) > cap.real
+    if slipping:
+        t = cap if t.real > 0.0 else -cap
+    for r in range(10):
+        f[r] = area * t * S[r]
+    f[0] -= area * p * sg * dx / dist
+    f[1] -= area * p * sg * dy / dist
+    f[v] += area * p * sg * dx / dist
+    f[v + 1] += area * p * sg * dy / dist
+    return g, p, t, s, slipping
+
+
+@numba.njit(cache=True, error_model="numpy")
+def node_to_vertex_friction(x, which, normal, offset, multiplier, penalty, area, eps_t, mu, cohesion, xi0, lam_t,
+                            with_tangent):
+    r"""Frictional contact of k slaves with master vertices (a sharp corner of the master surface:
+    its closest point is the vertex ``which`` (1: a, 2: b) of the slave's segment).
+
+    Normally as :func:`node_to_vertex` (g = ±|x_s − x_v|, the contact normal along
+    d = x_s − x_v). Tangentially the slave is attached to the stick point X₀ = Σ φ_k(ξ₀) x_k of its
+    segment's curve, as in :func:`node_to_smooth_segment_friction`, and its elastic slip is
+    s = (x_s − X₀)·τ_v along the unit tangent τ_v of the segment's curve at the vertex. A tangent
+    that turned with d instead would take the slave's motion around the vertex out of the slip
+    (at a sharp corner the contact point stays at the vertex) and, with a stick point some way
+    back along the segment, turn its slip into a force that grows as |d| shrinks; τ_v is bounded
+    and, at the edge of the vertex's region, the segment's own tangent there (the curve ends with
+    x'' = 0 at a sharp corner), so that slip, traction and the slave's force carry over. The same
+    Coulomb return map, force f = −A p ∂g/∂x + A t ∂s/∂x (gradients of rotation-invariant scalars:
+    frame-indifferent, momentum-conserving) and complex-step tangent K.
+
+    x: (k, 10) positions (x_s, x_p, x_a, x_b, x_q) of the segment's stencil; which (k,) int;
+    normal (k, 2) the vertices' averaged normals (the side of the gap's sign); offset, multiplier,
+    penalty, area, eps_t, mu, cohesion, xi0, lam_t: (k,). Returns g, p, t, s (k,), slipping (k,)
+    bool, f (k, 10), K (k, 10, 10)."""
+    k = x.shape[0]
+    g = np.empty(k)
+    p = np.zeros(k)
+    t = np.zeros(k)
+    s = np.zeros(k)
+    slipping = np.zeros(k, dtype=np.bool_)
+    f = np.zeros((k, 10))
+    K = np.zeros((k, 10, 10))
+    xc = np.empty(10, dtype=np.complex128)
+    fc = np.empty(10, dtype=np.complex128)
+    for i in range(k):
+        g[i], p[i], t[i], s[i], slipping[i] = _vertex_friction_force(
+            x[i], which[i], normal[i, 0], normal[i, 1], offset[i], multiplier[i], penalty[i], area[i], eps_t[i],
+            mu[i], cohesion[i], xi0[i], lam_t[i], f[i])
+        if not with_tangent or p[i] <= 0.0:
+            continue
+        for c in range(10):
+            for j in range(10):
+                xc[j] = x[i, j]
+            xc[c] += 1j * _H
+            _vertex_friction_force(xc, which[i], normal[i, 0], normal[i, 1], offset[i], multiplier[i] + 0j,
+                                   penalty[i], area[i], eps_t[i], mu[i], cohesion[i], xi0[i], lam_t[i] + 0j, fc)
+            for r in range(10):
+                K[i, r, c] = fc[r].imag / _H
+    return g, p, t, s, slipping, f, K
+
+
+@numba.njit(cache=True, error_model="numpy")
+def vertex_stick_point(x, which, xi0):
+    """The parameter ξ₁ of the point of the segment's curve right under a slave at a vertex (its
+    slip (x_s − X(ξ₁))·τ_v zero, :func:`node_to_vertex_friction`), by Newton from ξ₀; x (10,)
+    the converged positions."""
+    taux, tauy, _, _ = _vertex_tangent(x, which)
+    xi1 = xi0
+    for _ in range(30):
+        px, py, tx, ty, _, _, _, _ = _hermite(x, xi1)
+        ds = -(tx * taux + ty * tauy)
+        if ds == 0.0:
+            break
+        step = ((x[0] - px) * taux + (x[1] - py) * tauy) / ds
+        xi1 = xi1 - step
+        if abs(step) < 1e-14:
+            break
+    return xi1
+
+
+@numba.njit(cache=True, error_model="numpy")
 def curve_points(x, xi):
     """Points (k, 2) of the segments' curves at the parameters ξ (k,); x (k, 10) as in
     :func:`node_to_smooth_segment` (the slave's entries unused)."""

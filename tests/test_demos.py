@@ -21,7 +21,14 @@ DEMO_DIR = ROOT / "demos"
 DEMOS = sorted(p.stem for p in DEMO_DIR.glob("*.py"))
 MPI_DEMOS = ["euler_beam_2d", "cantilever_rollup_2d", "lee_frame", "curved_beam_3d", "rollup_3d", "truss_dome_3d",
              "strip_rollup", "cylinder_pullout", "hinged_sphere", "slit_annular_plate", "stiffened_strip", "euler_continuum_2d", "euler_continuum_3d", "hertz_2d", "contact_patch_test", "two_wheels", "beam_on_soil_2d", "lining_in_gap", "frame_filling_2", "hertz_3d", "pipe_on_soil_3d", "shell_on_soil_3d",
-             "contact_patch_test_3d", "sliding_sphere_3d", "cattaneo_mindlin_2d", "ironing_2d"]
+             "contact_patch_test_3d", "sliding_sphere_3d", "cattaneo_mindlin_2d", "ironing_2d", "ironing_3d"]
+
+# Demos whose two-rank numbers may depart from the serial ones by more than the solver's
+# tolerance, and by how much (relative to each series' largest value): in a frictional slide
+# the state of every step (stick points, tractions) is history, so where the ranks' round-off
+# stops a step's Newton iterations one iteration apart, the slide carries the difference on
+# (ironing_3d: measured 1.2e-5, 162 Newton iterations against 158; the reported digits agree)
+MPI_TOLERANCE = {"ironing_3d": 1e-4}
 
 
 def _run(cmd, outdir, timeout=900):
@@ -120,9 +127,10 @@ def test_demo_under_mpi_reproduces_serial_values(demo, serial_outputs, tmp_path)
     # (a penalty contact force, ε·gap, magnifies the gap's round-off by the penalty); a series
     # that is itself a round-off measure (rollup_3d's objectivity error, ~1e-11) differs between
     # runs by its round-off: the floor 1e-10
+    tolerance = MPI_TOLERANCE.get(demo, 1e-7)
     for key in set(a) - {"ranks", "load_factor"}:
         scale = float(np.max(np.abs(np.asarray(a[key], dtype=float)), initial=0.0))
-        np.testing.assert_allclose(b[key], a[key], rtol=0, atol=1e-7 * scale + 1e-10, err_msg=key)
+        np.testing.assert_allclose(b[key], a[key], rtol=0, atol=tolerance * scale + 1e-10, err_msg=key)
 
 
 @pytest.mark.mpi

@@ -14,16 +14,16 @@ E, NU, PRESS, STEPS = 1.0, 0.0, 0.01, 16
 SHIFT = np.array([0.02, 0.01])  # the push, oblique to both meshes
 
 
-def _pushed(tm, friction=None, held: bool = False, smooth: bool = False):
+def _pushed(tm, friction=None, held: bool = False, smooth: bool = False, push: dc.Amplitude | None = None):
     """The slider of :func:`test_contact3d._slider_3d` (1 × 1 × 0.5, spacing 0.25) on a base 10⁴
     times stiffer (faces 0.5), pressed by the settlement of its top in the first step (p ≈ 0.01),
     then pushed by SHIFT; one pass (the base hardly deforms); ``held``: the slider's bottom fixed
-    instead of contact (the sticking limit)."""
+    instead of contact (the sticking limit); ``push``: the push's amplitude instead of a ramp."""
     sc = dc.Scene(large_rotations=True, linear_solver="direct")
     b = sc.add_solid(tm, "slider", material=dc.SaintVenantKirchhoff(E, NU), degree=1)
     sc.add_solid(tm, "base_block", material=dc.SaintVenantKirchhoff(1e4 * E, NU), degree=1)
     sc.fix(b, "base")
-    push = dc.Amplitude(((0.0, 0.0), (1 / STEPS, 0.0), (1.0, 1.0)))
+    push = push or dc.Amplitude(((0.0, 0.0), (1 / STEPS, 0.0), (1.0, 1.0)))
     sc.prescribe(b, "top", amplitude=push, ux=SHIFT[0], uy=SHIFT[1])
     settle = dc.Amplitude(((0.0, 0.0), (1 / STEPS, 1.0), (1.0, 1.0)))
     sc.prescribe(b, "top", amplitude=settle, uz=-PRESS * 0.5 * (1 + NU) * (1 - 2 * NU) / ((1 - NU) * E))
@@ -70,6 +70,34 @@ def test_a_pressed_block_sticks_then_slides_with_mu_times_the_normal_force(quad,
     assert np.ptp(Fz[sliding]) < 1e-5 * abs(Fz[-1])
     direction = np.abs(Fy[sliding] / Fx[sliding] - 0.5)
     assert np.all(np.diff(direction) < 0.0) and direction[-1] < 3e-4, direction
+
+
+def test_a_load_reversal_unloads_elastically_then_slides_back_at_mu():
+    """The push along (2, 1) to +SHIFT (steps 2–7), then back to −SHIFT (steps 8–16), μ = 0.3:
+    the block slides forwards at μ times the normal force (1e-6), then, reversed, sticks again:
+    in the first step back its shear force changes as the held block's does (within 1.5 %;
+    measured 1.0 % and 1.1 %: the tangential penalty's compliance), passing through zero, and
+    it slides backwards, along the push's line, at μ times the normal force (1e-6) over the last
+    six steps. No cut: the first step back does not converge from the last step's slip state
+    (Newton's first correction lets the slaves slide freely along their old slip) and is tried
+    again, at once, from the elastic predictor (every slave sticks in its first evaluation):
+    32 Newton iterations then, with the AL's Uzawa updates (6–26 in the other steps); without
+    that second start it was cut twice."""
+    tm = _slider_3d(False)
+    push = dc.Amplitude(((0.0, 0.0), (1 / STEPS, 0.0), (7 / STEPS, 1.0), (1.0, -1.0)))
+    law = dc.Coulomb(mu=0.3, tangential_factor=20.0)
+    h = dc.solve(_pushed(tm, law, push=push), dc.LoadControl(steps=STEPS)).history
+    held = dc.solve(_pushed(tm, held=True, push=push), dc.LoadControl(steps=STEPS)).history
+    Fx, Fy, Fz = h.column("top_Fx"), h.column("top_Fy"), h.column("top_Fz")
+    iterations = h.column("iterations")
+    assert h.column("cuts").sum() == 0 and iterations.max() <= 35, iterations
+    np.testing.assert_array_equal(np.flatnonzero(h.column("elastic_restarts")), [7])
+    ratio = np.hypot(Fx, Fy) / -Fz
+    assert abs(ratio[6] / 0.3 - 1.0) < 1e-6 and Fx[6] * SHIFT[0] > 0.0, ratio  # forwards, at the end of the push
+    for col, F in (("top_Fx", Fx), ("top_Fy", Fy)):  # the first step back: elastic
+        assert F[7] - F[6] == pytest.approx(held.column(col)[7] - held.column(col)[6], rel=0.015)
+    assert np.abs(ratio[-6:] / 0.3 - 1.0).max() < 1e-6, ratio  # backwards, along the push's line
+    assert np.all(Fx[-6:] * SHIFT[0] < 0.0) and np.abs(Fy[-6:] / Fx[-6:] - 0.5).max() < 3e-3
 
 
 def test_the_augmented_lagrangian_makes_the_stick_exact():

@@ -637,10 +637,10 @@ class Killed(Exception):
     """Raised from on_step: the run dies after a step (its checkpoint holds the step before)."""
 
 
-def _box_in_pit_scene(slaves_on_fill: bool = True, size: float = 1.0):
+def _box_in_pit_scene(slaves_on_fill: bool = True, size: float = 1.0, friction=None):
     """A coarse box frame in a pit, filled in two layers (the frame-filling demos' scene): geostatic
     stage (reset), excavation (U_e), frame (U_os), two fill layers with frame–fill contact (slaves
-    on the fill's face, or on the frame)."""
+    on the fill's face, or on the frame; with ``friction``, a dc.Coulomb law)."""
     from dolfinx_corot.io.gmsh_models import box_in_pit
     tm, lines = box_in_pit(12.0, 8.0, 8.0, 4.0, 4.0, 2.0, 0.2, 1, 1, size)
     sc = dc.Scene(large_rotations=True, linear_solver="direct")
@@ -657,7 +657,7 @@ def _box_in_pit_scene(slaves_on_fill: bool = True, size: float = 1.0):
     for part in (soil, frame, slab):
         sc.gravity(part, (0.0, -10.0))
     faces = [(fill, "fill_face"), (frame, "frame")]
-    pair = sc.contact(*(faces if slaves_on_fill else faces[::-1]))
+    pair = sc.contact(*(faces if slaves_on_fill else faces[::-1]), friction=friction)
     sc.monitor_reaction("base", soil, "base")
     sc.monitor("floor", soil, "pit_floor", reduce="profile", along="x")
     stages = [Stage("geostatic", reset_displacements=True),
@@ -711,6 +711,59 @@ def test_a_staged_run_killed_and_restarted_reproduces_the_uninterrupted_one(tmp_
             np.testing.assert_allclose(mb.shift, ma.shift, rtol=0, atol=1e-14)
     # the fill presses on the frame (the interface's state came through the file)
     assert np.abs(pair3.resultant(on="slaves")).max() > 1e3
+    a, b = _staged_state(sc), _staged_state(sc3)
+    if comm.rank == 0:
+        assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()
+
+
+@pytest.mark.parametrize("approach", ["I", "II"])
+def test_friction_on_an_interface_that_appears_in_a_stage(tmp_path, approach):
+    """The box-in-pit scene with Coulomb friction μ = 0.3 between the fill and the frame: the
+    interface appears with the first layer (approach I: the gaps it finds taken as zero; II: the
+    fill's face mapped onto the frame) and the layers, settling under their weight, hang on the
+    frame's walls. Asserted: no cut; Coulomb's law at every slave at the end of each fill stage
+    (|t| ≤ μ p, to 1e-9 of the largest μ p; the slipping slaves at |t| = μ p); the fill's shear
+    drags the frame down: the vertical force of the fill on the frame exceeds the frictionless
+    run's (measured by 3.6 % (I) and 3.8 % (II); at the end 5 slaves in contact, 2 slipping);
+    and a run killed in the middle of layer 1 and restarted reproduces the uninterrupted
+    one step by step (1e-10)."""
+    law = dc.Coulomb(mu=0.3)
+    scenes = {}
+    for name, friction in (("frictionless", None), ("friction", law)):
+        sc, stages, initial, pair = _box_in_pit_scene(friction=friction)
+        ends = {}  # each stage's last step: the fill's force on the frame, the slaves' p, t, slipping
+
+        def record(stage, row, pair=pair, ends=ends):
+            itf = pair.interfaces[0]
+            ends[stage.name] = (pair.resultant(on="masters"), itf.pressure()[1], *itf.friction_traction()[1:])
+
+        results = solve_stages(sc, stages, approach=approach, initial=initial, on_step=record)
+        scenes[name] = (sc, results, ends)
+    sc, results, ends = scenes["friction"]
+    assert all(r.history.column("cuts").sum() == 0 for r in results)
+    for name in ("layer 1", "layer 2"):
+        resultant, p, t, slipping = ends[name]
+        bound = 0.3 * p.max()
+        assert bound > 0.0, name
+        assert np.all(np.abs(t) <= 0.3 * p + 1e-9 * bound), name
+        assert np.abs(np.abs(t[slipping]) - 0.3 * p[slipping]).max(initial=0.0) < 1e-9 * bound, name
+        assert np.abs(t).max() > 0.05 * bound, name
+    drag = [run[2]["layer 2"][0][1] for run in (scenes["frictionless"], scenes["friction"])]
+    assert drag[1] < drag[0] < 0.0, drag  # (downwards: more of the fill's weight on the frame)
+    path = comm.bcast(str(tmp_path / "staged.npz") if comm.rank == 0 else None, root=0)
+
+    def die(stage, row):
+        if (stage.name, row["step"]) == ("layer 1", 2):
+            raise Killed
+
+    sc2, stages2, initial2, _ = _box_in_pit_scene(friction=law)
+    with pytest.raises(Killed):
+        solve_stages(sc2, stages2, approach=approach, initial=initial2, on_step=die, checkpoint=path)
+    sc3, stages3, initial3, _ = _box_in_pit_scene(friction=law)
+    resumed = solve_stages(sc3, stages3, approach=approach, initial=initial3, checkpoint=path, restart=path)
+    for a, b in zip(results, resumed):
+        np.testing.assert_array_equal(b.history.column("iterations"), a.history.column("iterations"))
+        np.testing.assert_allclose(b.history.column("base_Fy"), a.history.column("base_Fy"), rtol=1e-9)
     a, b = _staged_state(sc), _staged_state(sc3)
     if comm.rank == 0:
         assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()

@@ -69,6 +69,11 @@ class Contribution:
     def before_solve(self) -> None:
         """A Newton solve starts (its first residual follows)."""
 
+    def another_start(self) -> bool:
+        """A step failed: True if this contribution offers another start for the same step (then
+        tried again before it is cut; the next :meth:`before_step` uses it)."""
+        return False
+
     def correction_rhs(self) -> tuple[np.ndarray, np.ndarray] | None:
         """Forces (dofs (k, n), f (k, n)) to subtract from the right-hand side of the next
         correction only (the residual keeps the true law), or None."""

@@ -563,6 +563,11 @@ class System:
         with self.step_dx.localForm() as s:
             s.set(0.0)
 
+    def another_start(self) -> bool:
+        """A step failed: whether some contribution offers another start for it (every one is
+        asked; see Contribution.another_start)."""
+        return any([c.another_start() for c in self.contributions])
+
     def begin_step(self) -> None:
         """A Newton solve starts (the step's first, or one after a contribution's update at the
         converged load factor): the contributions' hook."""

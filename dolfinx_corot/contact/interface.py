@@ -243,6 +243,7 @@ class Interface:
         self._assigned = None
         self.first_evaluation = True
         self.had_contact = False
+        self.predicting = False  # friction: the step's first evaluation is the elastic predictor
         self.band_used = 0
         self._virtual = None
         self.step_start = None  # slave and master positions at the start of the step (friction)
@@ -669,7 +670,7 @@ class Interface:
                 one = np.ones(len(j))
                 gj, xij, pj, tj, _, slipping, fj, Kj = node_to_smooth_segment_friction(
                     xj, sides[s[j]], offset[closed], lam[j], eps[j], self.area[s[j]], self.tangential_penalty * one,
-                    law.coefficient * one, law.cohesion * one, start, lam_t, True)
+                    self._coefficient * one, law.cohesion * one, start, lam_t, True)
                 f[j], K[j] = fj, Kj
                 trials.append(FrictionTrial(s[j], m[j], xj, xij, start, tj, slipping, pj, lam_t,
                                             np.zeros(len(j), dtype=np.int64)))
@@ -700,12 +701,21 @@ class Interface:
                     which = np.full(len(j), k)
                     _, pj, tj, _, slipping, fj, Kj = node_to_vertex_friction(
                         xj, which, normal_v[closed], offset[closed], lam[j], eps[j], self.area[s[j]],
-                        self.tangential_penalty * one, law.coefficient * one, law.cohesion * one, start, lam_t, True)
+                        self.tangential_penalty * one, self._coefficient * one, law.cohesion * one, start, lam_t,
+                        True)
                     f[j], K[j] = fj, Kj
                     trials.append(FrictionTrial(s[j], m[j], xj, np.full(len(j), k - 1.0), start, tj, slipping, pj,
                                                 lam_t, which))
         if trials:
             self._friction_trial = FrictionTrial(*(np.concatenate(parts) for parts in zip(*trials)))
+
+    @property
+    def _coefficient(self) -> float:
+        """Coulomb's μ for this evaluation: infinite in the elastic predictor (the first evaluation
+        of a step tried again, :meth:`Contact.another_start`), where every slave in contact sticks
+        (t = λ_T + ε_T s, the stick tangent): the step's first correction is then elastic, the right
+        one for a reversal."""
+        return np.inf if self.predicting else self.friction.coefficient
 
     def _closed(self, lam: np.ndarray, eps: np.ndarray, g: np.ndarray) -> np.ndarray:
         """The pairs with friction: those with a pressure above the touch band's (the round-off of
@@ -1010,6 +1020,10 @@ class Contact(Contribution):
         self.project = False
         self._engaged = False
         self._blocks = []
+        # friction: a step that failed is tried again, before it is cut, from the elastic predictor
+        self._elastic_start = False
+        self._restarted = False
+        self._friction = any(itf.friction is not None for itf in self.interfaces)
 
     def bind(self, system) -> None:
         for itf in self.interfaces:
@@ -1048,6 +1062,7 @@ class Contact(Contribution):
         self._blocks = []
         for itf in self.interfaces:
             dofs, f, K, pairs = itf.evaluate()
+            itf.predicting = False
             self._blocks.append((K, pairs))
             add(dofs, f)
         # some pair is a candidate: the bodies are near each other (Newton's safeguards apply)
@@ -1074,6 +1089,18 @@ class Contact(Contribution):
             itf.after_update = False
             itf.begin_step()
             itf.note_step_start()
+            itf.predicting = self._elastic_start and itf.friction is not None
+
+    def another_start(self) -> bool:
+        """A step failed: with friction, it is tried again from the elastic predictor (every slave
+        in contact sticks in the step's first evaluation, :attr:`Interface._coefficient`), once,
+        before the driver cuts it. Newton's first correction from the last step's slip state lets a
+        slave that slipped slide freely along its old slip; where the load turns back (a
+        reversal), whose first response is elastic, that start does not converge."""
+        if not self._friction or self._elastic_start:
+            return False
+        self._elastic_start = True
+        return True
 
     def before_solve(self) -> None:
         """A Newton solve starts: its first tangent is the exact one; each interface notes whether
@@ -1134,6 +1161,7 @@ class Contact(Contribution):
         """The step converged: the interfaces' stick points (friction) become the converged ones."""
         for itf in self.interfaces:
             itf.commit()
+        self._restarted, self._elastic_start = self._elastic_start, False
 
     def on_converged(self) -> bool:
         """One Uzawa update on every augmented interface that needs it; True if any changed."""
@@ -1143,7 +1171,10 @@ class Contact(Contribution):
         return changed
 
     def history(self, report) -> dict:
-        return {"uzawa_updates": report.updates}
+        out = {"uzawa_updates": report.updates}
+        if self._friction:  # the step needed the elastic predictor (its first attempt failed)
+            out["elastic_restarts"] = int(self._restarted)
+        return out
 
     # -- state ------------------------------------------------------------------------
     def checkpoint(self):

@@ -399,7 +399,7 @@ class Interface3D(Interface):
         g, p, slipping = np.zeros(n), np.zeros(n), np.zeros(n, dtype=bool)
         t, normal = np.zeros((n, 3)), np.zeros((n, 3))
         f, K = np.zeros((n, self.width)), np.zeros((n, self.width, self.width))
-        mu, c = self.friction.coefficient, float(self.friction.cohesion)
+        mu, c = self._coefficient, float(self.friction.cohesion)
         if len(moved):  # attached on the new face first (the line along the normal through the old
             # stick point), the multiplier then expressed on the new face's basis there
             lam_t[moved] = 0.0

@@ -9,7 +9,9 @@
 
 A step that fails is cut in half and retried from the exact last converged
 state (configuration, rotations, history), up to ``max_cuts`` times in a row.
-After all cuts a :class:`ConvergenceError` carries every converged step.
+Before the first cut a contribution may offer another start for the same step
+(frictional contact: the elastic predictor), tried once. After all cuts a
+:class:`ConvergenceError` carries every converged step.
 """
 from __future__ import annotations
 
@@ -159,6 +161,10 @@ class LoadControl:
                         run.fail(f"step {run.step + 1} to load factor {trial:.6g}: {absurd}")
                 if not report.converged:
                     system.restore(cp)
+                    if system.another_start():
+                        logger.info("step %d: lambda %.6g failed (%s); tried again from another start", run.step + 1,
+                                    trial, report.reason)
+                        continue
                     cuts += 1
                     run.cuts += 1
                     logger.info("step %d: lambda %.6g failed (%s); cut %d", run.step + 1, trial, report.reason, cuts)
@@ -535,6 +541,10 @@ class ArcLength:
                 report.reason = str(err)
             if not ok:
                 system.restore(cp)
+                if system.another_start():
+                    logger.info("arc-length step %d failed (%s); tried again from another start", run.step + 1,
+                                report.reason)
+                    continue
                 cuts += 1
                 run.cuts += 1
                 logger.info("arc-length step %d failed (%s); cut %d", run.step + 1, report.reason, cuts)

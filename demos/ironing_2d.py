@@ -162,7 +162,8 @@ def study(demo):
         iterations = history.column("iterations")
         row = {"h": h, "slaves": len(p), "steady_ratio": float(np.mean(ratio[steady])),
                "ratio_spike": spikes(ratio[steady]), "Fy_spike": spikes(Fy[steady]),
-               "steady_Fy": float(np.mean(Fy[steady])), "ratio_drift": float(np.ptp(ratio[steady]) / np.mean(ratio[steady])),
+               "steady_Fy": float(np.mean(Fy[steady])),
+               "ratio_drift": float(np.ptp(ratio[steady]) / np.mean(ratio[steady])),
                "in_contact": int(on.sum()), "all_slip": bool(slipping[on].all()),
                "cone": float(np.max(np.abs(np.abs(t[on]) / (MU * p[on]) - 1.0))),
                "cuts": int(history.column("cuts").sum()), "newton_iterations": int(iterations.sum()),

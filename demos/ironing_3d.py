@@ -119,7 +119,8 @@ def main() -> dict:
         out = run(tm, smooth, steps)
         rows.append(out)
         demo.say(f"{'smoothed' if smooth else 'flat    '} master: {out['dofs']} block dofs; steady ratio "
-                 f"{out['steady_ratio']:.4f} (μ = {MU}), off its trend by at most {100 * out['ratio_departure']:.2f} %; "
+                 f"{out['steady_ratio']:.4f} (μ = {MU}), off its trend by at most "
+                 f"{100 * out['ratio_departure']:.2f} %; "
                  f"F_z off its trend by {100 * out['Fz_departure']:.2f} %; {out['in_contact']} slaves under the die; "
                  f"{out['newton_iterations']} Newton its (at most {out['max_iterations']} a step), {out['cuts']} cuts, "
                  f"{out['wall_s']:.1f} s")

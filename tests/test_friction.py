@@ -132,9 +132,9 @@ def test_a_stick_point_is_followed_along_the_master_as_a_material_point():
     on a straight surface of equal segments it is the same point (1e-12); on a curved surface of
     unequal segments it is exact at the shared node, within 0.1 % of a segment a tenth of a segment
     from it (measured 0.05 %: the extrapolated curve of the neighbour), and comes back to itself
-    after going up to four segments away and back (1e-12). A slave that comes into contact is attached where it faced the master at the step's
-    start: on the segment it then faced (the same point as projected directly onto that segment),
-    even when it ends the step on another."""
+    after going up to four segments away and back (1e-12). A slave that comes into contact is
+    attached where it faced the master at the step's start: on the segment it then faced (the same
+    point as projected directly onto that segment), even when it ends the step on another."""
     tm = rectangles({"a": (0.0, 0.0, 6.0, 1.0, 6, 1), "b": (0.0, 1.0, 1.0, 1.0, 1, 1)},
                     {"a_top": [("a", "top")], "b_bottom": [("b", "bottom")]}, comm=comm)
     sc = dc.Scene()

@@ -243,7 +243,7 @@ class Interface:
         self._assigned = None
         self.first_evaluation = True
         self.had_contact = False
-        self.predicting = False  # friction: the step's first evaluation is the elastic predictor
+        self.predicting = False  # friction: the elastic predictor in this evaluation (a step tried again)
         self.band_used = 0
         self._virtual = None
         self.step_start = None  # slave and master positions at the start of the step (friction)

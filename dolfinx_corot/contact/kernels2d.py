@@ -561,7 +561,8 @@ def _vertex_friction_force(x, which, nbx, nby, offset, lam, eps, area, eps_t, mu
     r0x = x[0] - (w0[0] * x[2] + w0[1] * x[4] + w0[2] * x[6] + w0[3] * x[8])
     r0y = x[1] - (w0[0] * x[3] + w0[1] * x[5] + w0[2] * x[7] + w0[3] * x[9])
     s = r0x * taux + r0y * tauy
-    # δs = (δx_s − Σ φ_k(ξ₀) δx_k)·τ + (r₀·ν/|x'|) ν·Σ dφ_k δx_k, ν = (τ_y, −τ_x): τ turns with the nodes
+    # δs = (δx_s − Σ φ_k(ξ₀) δx_k)·τ + (r₀·ν/|x'|) ν·Σ dφ_k δx_k, ν = (τ_y, −τ_x): τ turns with
+    # the nodes
     q = (r0x * tauy - r0y * taux) / la
     S = np.empty(10, dtype=x.dtype)
     S[0] = taux

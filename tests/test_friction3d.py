@@ -82,8 +82,10 @@ def test_a_load_reversal_unloads_elastically_then_slides_back_at_mu():
     (Newton's first correction lets the slaves slide freely along their old slip) and is tried
     again, at once, from the elastic predictor (every slave sticks in its first evaluation),
     from which Newton converges in 4 iterations; the step's 10 Uzawa updates of the pressure
-    (gap_tolerance 1e-8) and their re-solves bring it to 32 (48 on two ranks; 6–26 in the other
-    steps). Without that second start the step was cut twice."""
+    (gap_tolerance 1e-8) and their re-solves bring it to 32 (6–26 in the other steps). Without
+    that second start the step was cut twice. On two ranks the first start sometimes converges
+    within its 25 iterations and sometimes not (the parallel solver's round-off differs from run
+    to run; 48 iterations with the second start)."""
     tm = _slider_3d(False)
     push = dc.Amplitude(((0.0, 0.0), (1 / STEPS, 0.0), (7 / STEPS, 1.0), (1.0, -1.0)))
     law = dc.Coulomb(mu=0.3, tangential_factor=20.0)
@@ -92,7 +94,8 @@ def test_a_load_reversal_unloads_elastically_then_slides_back_at_mu():
     Fx, Fy, Fz = h.column("top_Fx"), h.column("top_Fy"), h.column("top_Fz")
     iterations = h.column("iterations")
     assert h.column("cuts").sum() == 0 and iterations.max() <= 60, iterations
-    np.testing.assert_array_equal(np.flatnonzero(h.column("elastic_restarts")), [7])
+    restarts = np.flatnonzero(h.column("elastic_restarts"))
+    assert list(restarts) == [7] if comm.size == 1 else set(restarts) <= {7}, restarts
     ratio = np.hypot(Fx, Fy) / -Fz
     assert abs(ratio[6] / 0.3 - 1.0) < 1e-6 and Fx[6] * SHIFT[0] > 0.0, ratio  # forwards, at the end of the push
     for col, F in (("top_Fx", Fx), ("top_Fy", Fy)):  # the first step back: elastic

@@ -726,7 +726,10 @@ def test_friction_on_an_interface_that_appears_in_a_stage(tmp_path, approach):
     drags the frame down: the vertical force of the fill on the frame exceeds the frictionless
     run's (measured by 3.6 % (I) and 3.8 % (II); at the end 5 slaves in contact, 2 slipping);
     and a run killed in the middle of layer 1 and restarted reproduces the uninterrupted
-    one step by step (1e-10)."""
+    one step by step (1e-10). On two ranks the parallel direct solver's round-off differs from
+    one run to the next, and the iteration count of a step with a slave at the limit of stick
+    and slip follows it (layer 2's first step: 5, 7 or 10 iterations): there the state is
+    compared, to 1e-8 (measured 1e-13)."""
     law = dc.Coulomb(mu=0.3)
     scenes = {}
     for name, friction in (("frictionless", None), ("friction", law)):
@@ -761,12 +764,14 @@ def test_friction_on_an_interface_that_appears_in_a_stage(tmp_path, approach):
         solve_stages(sc2, stages2, approach=approach, initial=initial2, on_step=die, checkpoint=path)
     sc3, stages3, initial3, _ = _box_in_pit_scene(friction=law)
     resumed = solve_stages(sc3, stages3, approach=approach, initial=initial3, checkpoint=path, restart=path)
+    serial = comm.size == 1
     for a, b in zip(results, resumed):
-        np.testing.assert_array_equal(b.history.column("iterations"), a.history.column("iterations"))
+        if serial:
+            np.testing.assert_array_equal(b.history.column("iterations"), a.history.column("iterations"))
         np.testing.assert_allclose(b.history.column("base_Fy"), a.history.column("base_Fy"), rtol=1e-9)
     a, b = _staged_state(sc), _staged_state(sc3)
     if comm.rank == 0:
-        assert np.abs(a - b).max() <= 1e-10 * np.abs(a).max()
+        assert np.abs(a - b).max() <= (1e-10 if serial else 1e-8) * np.abs(a).max()
 
 
 def test_a_staged_restart_refuses_another_approach_other_stages_a_plain_solve_or_another_mesh(tmp_path):

@@ -9,12 +9,15 @@ frictionless interface.
    Once the block slides, |ΣF_t|/|ΣF_n| of the base's reaction is μ; reported with the wall
    time, Newton iterations and dofs for two meshes (1.3k and 5.5k dofs; the peer:
    CalculiX, quadratic elements, surface-to-surface penalty, one thread: 19 s and 49 s,
-   |ΣF_t|/|ΣF_n| = 0.2999998).
+   |ΣF_t|/|ΣF_n| = 0.2999998) and two predictors: each step started from the last converged
+   state (the default), or from the secant extrapolation of the last two
+   (``LoadControl(extrapolate=True)``), which in steady sliding starts the slaves where they slide
+   to.
 2. Effects on demand: the same scene without friction (the block then follows its top
-   without resistance), solved by this code and by the code before friction existed (``--baseline REV``, a git revision; run from
-   a temporary worktree in a child process), alternately, ``--repeat`` times each: the
-   median wall times and the reactions are compared (target: the same time within the
-   machine's noise, the same numbers to round-off).
+   without resistance), solved by this code and by the code before friction existed
+   (``--baseline REV``, a git revision; run from a temporary worktree in a child process),
+   alternately, ``--repeat`` times each: the median wall times and the reactions are compared
+   (target: the same time within the machine's noise, the same numbers to round-off).
 
 Writes output/friction/friction.{json,csv,png}.
 Usage: python benchmarks/friction.py [--meshes 32 16 70 35] [--baseline 6245b6d^] [--repeat 3]
@@ -36,7 +39,7 @@ comm = MPI.COMM_WORLD
 E, NU, PRESSURE, MU, SHIFT, STEPS = 1000.0, 0.3, 10.0, 0.3, 0.05, 11
 
 
-def run(nx: int, ny: int, friction: bool) -> dict:
+def run(nx: int, ny: int, friction: bool, extrapolate: bool = False) -> dict:
     import dolfinx_corot as dc
     from dolfinx_corot.io.mesh import rectangles
 
@@ -55,14 +58,16 @@ def run(nx: int, ny: int, friction: bool) -> dict:
     sc.contact((block, "block_bottom"), (base, "base_top"), law=dc.AugmentedLagrangian(), **kwargs)
     sc.monitor_reaction("base", base, "base")
     t0 = time.perf_counter()
-    result = dc.solve(sc, dc.LoadControl(steps=STEPS))
+    result = dc.solve(sc, dc.LoadControl(steps=STEPS, extrapolate=extrapolate))
     wall = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
     h = result.history
     fx, fy = h.column("base_Fx"), h.column("base_Fy")
-    return {"nx": nx, "ny": ny, "friction": friction, "dofs": int(2 * tm.mesh.topology.index_map(0).size_global), "wall_s": wall,
+    return {"nx": nx, "ny": ny, "friction": friction, "predictor": "secant" if extrapolate else "last state",
+            "dofs": int(2 * tm.mesh.topology.index_map(0).size_global), "wall_s": wall,
             "newton_iterations": int(h.column("iterations").sum()), "cuts": int(h.column("cuts").sum()),
             "ratio": float(abs(fx[-1] / fy[-1])), "steps": [int(v) for v in h.column("iterations")],
-            "uzawa": [int(v) for v in h.column("uzawa_updates")], "base_Fx": [float(v) for v in fx], "base_Fy": [float(v) for v in fy]}
+            "uzawa": [int(v) for v in h.column("uzawa_updates")], "base_Fx": [float(v) for v in fx],
+            "base_Fy": [float(v) for v in fy]}
 
 
 def child(args) -> None:
@@ -116,14 +121,16 @@ def main():
     from dolfinx_corot.io import output_dir
 
     rows, histories = [], []
-    for nx, ny in zip(args.meshes[::2], args.meshes[1::2]):
-        run(nx, ny, True)  # compiles the kernels once
-        r = run(nx, ny, True)
-        rows.append({k: v for k, v in r.items() if not k.startswith("base_")})
-        histories.append(r)
-        if comm.rank == 0:
-            print(f"block {nx} × {ny}: {r['dofs']} dofs, |ΣF_t|/|ΣF_n| = {r['ratio']:.7f} (μ = {MU}), "
-                  f"{r['newton_iterations']} Newton its {r['steps']}, Uzawa {r['uzawa']}, {r['cuts']} cuts, {r['wall_s']:.2f} s")
+    run(args.meshes[0], args.meshes[1], True)  # compiles the kernels once
+    for extrapolate in (False, True):
+        for nx, ny in zip(args.meshes[::2], args.meshes[1::2]):
+            r = run(nx, ny, True, extrapolate)
+            rows.append({k: v for k, v in r.items() if not k.startswith("base_")})
+            histories.append(r)
+            if comm.rank == 0:
+                print(f"block {nx} × {ny} ({r['predictor']} predictor): {r['dofs']} dofs, |ΣF_t|/|ΣF_n| = "
+                      f"{r['ratio']:.7f} (μ = {MU}), {r['newton_iterations']} Newton its {r['steps']}, Uzawa "
+                      f"{r['uzawa']}, {r['cuts']} cuts, {r['wall_s']:.2f} s")
     report = {"sliding_block": rows}
     if args.baseline is not None and comm.size == 1:
         nx, ny = args.meshes[-2:]
@@ -149,11 +156,15 @@ def main():
         fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
         for r in histories:
             ratio = np.abs(np.divide(r["base_Fx"], r["base_Fy"]))
-            axes[0].plot(np.arange(1, len(ratio) + 1), ratio, "o-", ms=3, label=f"{r['dofs']} dofs")
+            axes[0].plot(np.arange(1, len(ratio) + 1), ratio, "o-" if r["predictor"] == "secant" else "x:", ms=3,
+                         label=f"{r['dofs']} dofs, {r['predictor']} predictor")
         axes[0].axhline(MU, color="k", lw=0.8)
         axes[0].set(xlabel="step", ylabel="|ΣF_t| / |ΣF_n| of the base", title="pressed, then pushed (line: μ)")
         axes[0].legend(fontsize=7)
-        axes[1].loglog([r["dofs"] for r in histories], [r["wall_s"] for r in histories], "o-", label="this code")
+        for predictor, style in (("last state", "o:"), ("secant", "o-")):
+            these = [r for r in histories if r["predictor"] == predictor]
+            axes[1].loglog([r["dofs"] for r in these], [r["wall_s"] for r in these], style,
+                           label=f"this code, {predictor} predictor")
         axes[1].loglog([1600, 5300], [19.0, 49.0], "s--", label="CalculiX (issue 16)")
         if "frictionless" in report:
             f = report["frictionless"]

@@ -49,8 +49,8 @@ import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
-from dolfinx_corot.gallery import Demo, timed
-from sliding_sphere_3d import E, E_DIE, NU, PRESS, STEADY, die_motion, mesh
+from dolfinx_corot.gallery import Demo
+from sliding_sphere_3d import STEADY, departure, mesh, slide
 
 comm = MPI.COMM_WORLD
 MU = 0.3
@@ -61,44 +61,24 @@ MU = 0.3
 
 # %%
 def run(tm, smooth: bool, steps: int) -> dict:
-    sc = dc.Scene(large_rotations=True, linear_solver="direct")
-    block = sc.add_solid(tm, "block", material=dc.NeoHookean(E, NU), degree=1)
-    die = sc.add_solid(tm, "die", material=dc.NeoHookean(E_DIE, NU), degree=1)
-    sc.fix(block, "base")
-    sc.fix(block, "xends", dofs=("ux",))
-    sc.fix(block, "ysym", dofs=("uy",))
-    sc.fix(block, "yfar", dofs=("uy",))
-    sc.fix(die, "die_sym", dofs=("uy",))
-    sc.prescribe(die, "die_top", ux=lambda lam, stage: die_motion(lam)[0], uz=lambda lam, stage: die_motion(lam)[1])
-    pair = sc.contact((block, "top"), (die, "die_face"), law=dc.Penalty(), smooth=smooth,
-                      friction=dc.Coulomb(mu=MU))
-    sc.monitor_contact("contact", pair)
-    sc.monitor_reaction("die", die, "die_top")
-    press = max(2, round(steps * PRESS))
-    lams = np.concatenate([np.linspace(0.0, PRESS, press + 1)[1:], np.linspace(PRESS, 1.0, steps - press + 1)[1:]])
-    res, wall = timed(dc.solve, sc, dc.LoadControl(load_factors=list(lams)))
+    h, wall, block, pair, travel, steady = slide(tm, smooth, steps, friction=dc.Coulomb(mu=MU))
     (itf,) = pair.interfaces
     _, p = itf.pressure()
     _, t, slipping = itf.friction_traction()
     on = p > 0.0
-    h = res.history
-    lam = h.column("load_factor")
-    travel = np.array([die_motion(v)[0] for v in lam])
     fz, fx = h.column("die_Fz"), h.column("die_Fx")  # the force the support exerts on the die
     ratio = -fx / fz  # (the block drags the die back and pushes it up)
-    steady = (travel >= STEADY[0] - 1e-9) & (travel <= STEADY[1] + 1e-9)
 
-    def departure(values: np.ndarray) -> float:
+    def departure_from_trend(values: np.ndarray) -> float:
         """The largest departure of ``values`` from their linear trend over the steady slide / their mean."""
-        trend = np.polyval(np.polyfit(travel[steady], values[steady], 1), travel[steady])
-        return float(np.abs(values[steady] - trend).max() / abs(values[steady].mean()))
+        return departure(travel, steady, values, abs(values[steady].mean()))
 
     iterations = h.column("iterations")
     return {"smooth": smooth, "dofs": 3 * block.model.V.dofmap.index_map.size_global, "wall_s": wall,
             "newton_iterations": int(iterations.sum()), "max_iterations": int(iterations.max()),
             "uzawa_updates": int(h.column("uzawa_updates").sum()), "cuts": int(h.column("cuts").sum()),
-            "steady_ratio": float(ratio[steady].mean()), "ratio_departure": departure(ratio),
-            "Fz_departure": departure(fz), "mean_Fz": float(-fz[steady].mean()),
+            "steady_ratio": float(ratio[steady].mean()), "ratio_departure": departure_from_trend(ratio),
+            "Fz_departure": departure_from_trend(fz), "mean_Fz": float(-fz[steady].mean()),
             "in_contact": int(on.sum()), "all_slip": bool(slipping[on].all()),
             "cone": float(np.max(np.abs(np.linalg.norm(t[on], axis=1) / (MU * p[on]) - 1.0))),
             "balance": float(np.abs(np.column_stack([fx - h.column("contact_Fx"), fz - h.column("contact_Fz")])).max()

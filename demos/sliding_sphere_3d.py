@@ -129,7 +129,11 @@ def mesh(h_block: float, h_die: float = 0.25):
 # ## The scene: the block's top nodes against the die's faces
 
 # %%
-def run(tm, smooth: bool, steps: int) -> dict:
+def slide(tm, smooth: bool, steps: int, friction=None, law=None):
+    """The die pressed, then slid, in ``steps`` steps (a fifth of them pressing); the block's top
+    nodes against the die's faces (``law``: the normal law, dc.Penalty() if None; ``friction``: a
+    dc.Coulomb law, or None). Returns (history, wall time, the block, the contact pair, the die's
+    travel at each step, which steps slide steadily)."""
     sc = dc.Scene(large_rotations=True, linear_solver="direct")
     block = sc.add_solid(tm, "block", material=dc.NeoHookean(E, NU), degree=1)
     die = sc.add_solid(tm, "die", material=dc.NeoHookean(E_DIE, NU), degree=1)
@@ -139,23 +143,33 @@ def run(tm, smooth: bool, steps: int) -> dict:
     sc.fix(block, "yfar", dofs=("uy",))
     sc.fix(die, "die_sym", dofs=("uy",))
     sc.prescribe(die, "die_top", ux=lambda lam, stage: die_motion(lam)[0], uz=lambda lam, stage: die_motion(lam)[1])
-    pair = sc.contact((block, "top"), (die, "die_face"), law=dc.Penalty(), smooth=smooth)
+    pair = sc.contact((block, "top"), (die, "die_face"), law=law or dc.Penalty(), smooth=smooth, friction=friction)
     sc.monitor_contact("contact", pair)
     sc.monitor_reaction("die", die, "die_top")
     press = max(2, round(steps * PRESS))
     lams = np.concatenate([np.linspace(0.0, PRESS, press + 1)[1:], np.linspace(PRESS, 1.0, steps - press + 1)[1:]])
     res, wall = timed(dc.solve, sc, dc.LoadControl(load_factors=list(lams)))
     h = res.history
-    lam = h.column("load_factor")
-    travel = np.array([die_motion(v)[0] for v in lam])
-    fz, fx = h.column("die_Fz"), h.column("die_Fx")  # the force the support exerts on the die
+    travel = np.array([die_motion(v)[0] for v in h.column("load_factor")])
     steady = (travel >= STEADY[0] - 1e-9) & (travel <= STEADY[1] + 1e-9)
+    return h, wall, block, pair, travel, steady
+
+
+def departure(travel: np.ndarray, steady: np.ndarray, values: np.ndarray, scale: float) -> float:
+    """The largest departure of ``values`` from their linear trend over the steady slide, over ``scale``."""
+    trend = np.polyval(np.polyfit(travel[steady], values[steady], 1), travel[steady])
+    return float(np.abs(values[steady] - trend).max() / scale)
+
+
+def run(tm, smooth: bool, steps: int) -> dict:
+    h, wall, block, pair, travel, steady = slide(tm, smooth, steps)
+    lam = h.column("load_factor")
+    fz, fx = h.column("die_Fz"), h.column("die_Fx")  # the force the support exerts on the die
     mean = float(-fz[steady].mean())
 
     def spike(force: np.ndarray) -> float:
         """The largest departure of ``force`` from its linear trend over the steady slide / mean Fz."""
-        trend = np.polyval(np.polyfit(travel[steady], force[steady], 1), travel[steady])
-        return float(np.abs(force[steady] - trend).max() / mean)
+        return departure(travel, steady, force, mean)
 
     return {"smooth": smooth, "dofs": 3 * block.model.V.dofmap.index_map.size_global, "wall_s": wall,
             "newton_iterations": int(h.column("iterations").sum()), "max_iterations": int(h.column("iterations").max()),

@@ -127,15 +127,28 @@ def test_frame_indifference_and_momentum(slipping):
     xi = _evaluate(x, 0.0)[1][0]
     xi0 = xi - (0.05 if slipping else 0.002)
     out = _evaluate(x, xi0, 0.5, 0.3)
-    c, sn = np.cos(2.3), np.sin(2.3)
-    Q = np.array([[c, -sn], [sn, c]])
-    y = (x.reshape(5, 2) @ Q.T + [4.0, -7.0]).ravel()
+    Q, y = _turned(x)
     moved = _evaluate(y, xi0, 0.5, 0.3)
     assert out[5][0] == slipping and moved[5][0] == slipping
-    for j in (0, 2, 3, 4):  # g, p, t, s
-        assert moved[j][0] == pytest.approx(out[j][0], rel=1e-10, abs=1e-14)  # coordinates of 7 against gaps of 0.02
-    f = out[6][0].reshape(5, 2)
-    assert np.abs(moved[6][0].reshape(5, 2) - f @ Q.T).max() < 1e-12 * np.abs(f).max()
+    _assert_objective([out[j][0] for j in (0, 2, 3, 4)], [moved[j][0] for j in (0, 2, 3, 4)], out[6][0],
+                      moved[6][0], Q, x)  # g, p, t, s; f
+
+
+def _turned(x):
+    """The rotation Q by 2.3 rad and the pair x turned by it and moved by (4, −7)."""
+    c, sn = np.cos(2.3), np.sin(2.3)
+    Q = np.array([[c, -sn], [sn, c]])
+    return Q, (x.reshape(5, 2) @ Q.T + [4.0, -7.0]).ravel()
+
+
+def _assert_objective(scalars, moved_scalars, f, moved_f, Q, x):
+    """The pair's scalars (gap, pressure, traction, slip) unchanged by a rigid motion Q (1e-10: the
+    coordinates, 7, against gaps of 0.02, cost three digits), its forces f (10,) turned with it
+    (1e-12); they sum to zero and their moment about the origin vanishes (1e-13)."""
+    for a, b in zip(moved_scalars, scalars):
+        assert a == pytest.approx(b, rel=1e-10, abs=1e-14)
+    f = f.reshape(5, 2)
+    assert np.abs(moved_f.reshape(5, 2) - f @ Q.T).max() < 1e-12 * np.abs(f).max()
     assert np.abs(f.sum(axis=0)).max() < 1e-13 * np.abs(f).max()
     X = x.reshape(5, 2)
     assert abs(np.sum(X[:, 0] * f[:, 1] - X[:, 1] * f[:, 0])) < 1e-13 * np.abs(f).max() * 10
@@ -264,18 +277,10 @@ def test_at_a_corner_frame_indifference_and_momentum(slipping):
     x, normal = _corner(2)
     xi0 = vertex_stick_point(x, 2, 0.9) - (0.1 if slipping else 0.002)  # (from right under the slave)
     out = _at_vertex(x, normal, xi0, 2.0, 0.3)
-    c, sn = np.cos(2.3), np.sin(2.3)
-    Q = np.array([[c, -sn], [sn, c]])
-    y = (x.reshape(5, 2) @ Q.T + [4.0, -7.0]).ravel()
+    Q, y = _turned(x)
     moved = _at_vertex(y, Q @ normal, xi0, 2.0, 0.3)
     assert out[4][0] == slipping and moved[4][0] == slipping
-    for j in range(4):
-        assert moved[j][0] == pytest.approx(out[j][0], rel=1e-10, abs=1e-14)
-    f = out[5][0].reshape(5, 2)
-    assert np.abs(moved[5][0].reshape(5, 2) - f @ Q.T).max() < 1e-12 * np.abs(f).max()
-    assert np.abs(f.sum(axis=0)).max() < 1e-13 * np.abs(f).max()
-    X = x.reshape(5, 2)
-    assert abs(np.sum(X[:, 0] * f[:, 1] - X[:, 1] * f[:, 0])) < 1e-13 * np.abs(f).max() * 10
+    _assert_objective([v[0] for v in out[:4]], [v[0] for v in moved[:4]], out[5][0], moved[5][0], Q, x)
 
 
 def test_a_slave_slipping_at_a_corner_is_attached_right_under_itself():

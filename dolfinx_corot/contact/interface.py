@@ -947,18 +947,13 @@ class Interface:
         t = np.zeros((n, 3)) if self.slave.gdim == 3 else np.zeros(n)
         slip = np.zeros(n)
         if self._friction_trial is not None:
-            s, t_pairs, slipping = self._friction_state()
-            t[s] = t_pairs
-            slip[s] = slipping
+            tr = self._friction_trial
+            t[tr.s] = tr.t
+            slip[tr.s] = tr.slipping
         out_t, out_slip = np.zeros_like(t), np.zeros_like(slip)
         self.comm.Allreduce(t, out_t, op=MPI.SUM)
         self.comm.Allreduce(slip, out_slip, op=MPI.SUM)
         return self.slave.X, out_t, out_slip > 0.5
-
-    def _friction_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(slaves, tractions, slipping) of the closed pairs at the last evaluation, this rank's."""
-        tr = self._friction_trial
-        return tr.s, tr.t, tr.slipping
 
     @property
     def contact_forces(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

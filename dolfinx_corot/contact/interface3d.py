@@ -38,6 +38,8 @@ width). Frictionless.
 """
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from mpi4py import MPI
 
@@ -47,6 +49,21 @@ from .laws import ContactError, Coulomb, Penalty
 from .search3d import broad_phase_boxes, face_boxes
 
 PAIR_DOFS = kernels3d.PAIR_DOFS
+
+
+class FaceFrictionTrial(NamedTuple):
+    """The closed pairs' friction at the last evaluation (this rank's): slaves s, faces m, whether
+    on a smoothed patch (curved), stick points xi (k, 2), slipping, tractions t (k, 3), contact
+    normals (k, 3), slave positions x_s (k, 3) and the multipliers' components lam_t (k, 3)."""
+    s: np.ndarray
+    m: np.ndarray
+    curved: np.ndarray
+    xi: np.ndarray
+    slipping: np.ndarray
+    t: np.ndarray
+    normal: np.ndarray
+    x_s: np.ndarray
+    lam_t: np.ndarray
 
 
 def tributary_areas(X: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -421,13 +438,9 @@ class Interface3D(Interface):
         self.trial_segment[s[changed]] = m[changed]
         self.trial_xi[s[changed]] = xi0[changed]
         self.trial_lambda[s[changed]] = lam_t[changed]
-        self._friction_trial = (s[closed], m[closed], curved[closed], xi0[closed], slipping[closed], t[closed],
-                                normal[closed], xs[s[closed]], lam_t[closed])
+        self._friction_trial = FaceFrictionTrial(s[closed], m[closed], curved[closed], xi0[closed], slipping[closed],
+                                                 t[closed], normal[closed], xs[s[closed]], lam_t[closed])
         return g, f, K
-
-    def _friction_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        s, m, curved, xi, slipping, t, normal, x_s, lam_t = self._friction_trial
-        return s, t, slipping
 
     def _bases(self, xm: np.ndarray, faces: np.ndarray, xi0: np.ndarray, curved: np.ndarray) -> np.ndarray:
         """The convected bases (k, 3, 3) (rows a₁, a₂, a₁ × a₂) of faces (their patches where
@@ -442,8 +455,8 @@ class Interface3D(Interface):
         on = np.flatnonzero(curved)
         if len(on):
             b1, b2 = np.zeros((len(on), 3)), np.zeros((len(on), 3))
-            smooth3d.patch_frames(xm, self.ext, self.nodes, self.star, self.nstar, faces[on], xi0[on], np.zeros_like(b1),
-                                  b1, b2)
+            smooth3d.patch_frames(xm, self.ext, self.nodes, self.star, self.nstar, faces[on], xi0[on],
+                                  np.zeros_like(b1), b1, b2)
             a1[on], a2[on] = b1, b2
         return np.stack([a1, a2, np.cross(a1, a2)], axis=1)
 
@@ -479,20 +492,20 @@ class Interface3D(Interface):
     def stick_slip(self) -> float:
         worst = 0.0
         if self._friction_trial is not None:
-            s, m, curved, xi, slipping, t, normal, x_s, lam_t = self._friction_trial
-            i = np.flatnonzero(~slipping)
+            tr = self._friction_trial
+            i = np.flatnonzero(~tr.slipping)
             if len(i):
-                v = self._multiplier_vectors(self._x[1], m[i], xi[i], lam_t[i], curved[i])
-                v -= np.einsum("kd,kd->k", v, normal[i])[:, None] * normal[i]  # (in the tangent plane)
-                worst = float(np.linalg.norm(t[i] - v, axis=1).max()) / self.tangential_penalty
+                v = self._multiplier_vectors(self._x[1], tr.m[i], tr.xi[i], tr.lam_t[i], tr.curved[i])
+                v -= np.einsum("kd,kd->k", v, tr.normal[i])[:, None] * tr.normal[i]  # (in the tangent plane)
+                worst = float(np.linalg.norm(tr.t[i] - v, axis=1).max()) / self.tangential_penalty
         return self.comm.allreduce(worst, op=MPI.MAX)
 
     def augment_tangential(self) -> None:
         if self._friction_trial is None:
             return
-        s, m, curved, xi, slipping, t, normal, x_s, lam_t = self._friction_trial
-        i = np.flatnonzero(~slipping)  # (see Interface.augment_tangential)
-        self.trial_lambda[s[i]] = self._multiplier_components(self._x[1], m[i], xi[i], t[i], curved[i])
+        tr = self._friction_trial
+        i = np.flatnonzero(~tr.slipping)  # (see Interface.augment_tangential)
+        self.trial_lambda[tr.s[i]] = self._multiplier_components(self._x[1], tr.m[i], tr.xi[i], tr.t[i], tr.curved[i])
 
     def _stick_points(self, xm: np.ndarray, faces: np.ndarray, xi0: np.ndarray) -> np.ndarray:
         """The current positions (k, 3) of the stick points (ξ₀, η₀) on faces: of the flat faces, or
@@ -515,11 +528,11 @@ class Interface3D(Interface):
         xi0 = np.zeros((len(self.area), 2))
         lam0 = np.zeros((len(self.area), 3))
         if self._friction_trial is not None:
-            s, m, curved, xi, slipping, t, normal, x_s, lam_t = self._friction_trial
-            new_xi, new_lam = self._slipped(self._x[1], m, curved, xi, slipping, t, normal, x_s)
-            seg[s] = m
-            xi0[s] = np.where(slipping[:, None], new_xi, xi)
-            lam0[s] = np.where(slipping[:, None], new_lam, lam_t)
+            tr = self._friction_trial
+            new_xi, new_lam = self._slipped(self._x[1], tr.m, tr.curved, tr.xi, tr.slipping, tr.t, tr.normal, tr.x_s)
+            seg[tr.s] = tr.m
+            xi0[tr.s] = np.where(tr.slipping[:, None], new_xi, tr.xi)
+            lam0[tr.s] = np.where(tr.slipping[:, None], new_lam, tr.lam_t)
         self.commit_stick_points(seg, xi0, lam0)
 
     def _idle(self, width: int):

@@ -420,6 +420,26 @@ def slip(x, xi, xi0, out):
     return r0x * taux + r0y * tauy
 
 
+@numba.njit(cache=True)
+def _friction_arrays(k):
+    """The outputs of k frictional pairs — g, p, t, s (k,), slipping (k,), f (k, 10), K (k, 10, 10)
+    — and the complex-step work arrays x, f (10,)."""
+    return (np.empty(k), np.zeros(k), np.zeros(k), np.zeros(k), np.zeros(k, dtype=np.bool_), np.zeros((k, 10)),
+            np.zeros((k, 10, 10)), np.empty(10, dtype=np.complex128), np.empty(10, dtype=np.complex128))
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _return_map(lam_t, eps_t, s, cohesion, mu, p):
+    """Coulomb's traction along the tangent: the predictor λ_T + ε_T s returned onto the slip
+    surface |t| ≤ c + μ p (decided on the real parts); returns (t, slipping)."""
+    t = lam_t + eps_t * s
+    cap = cohesion + mu * p
+    slipping = abs(t.real) > cap.real
+    if slipping:
+        t = cap if t.real > 0.0 else -cap
+    return t, slipping
+
+
 @numba.njit(cache=True, error_model="numpy")
 def _friction_force(x, xi, side, offset, lam, eps, area, eps_t, mu, cohesion, xi0, lam_t, f):
     """Gap, pressure, traction, slip and force f (10,) of one pair at the closest point ξ (the
@@ -433,11 +453,7 @@ def _friction_force(x, xi, side, offset, lam, eps, area, eps_t, mu, cohesion, xi
             f[r] = 0.0
         return g, 0.0 * p, 0.0 * p, 0.0 * p, False
     s = slip(x, xi, xi0, S)
-    t = lam_t + eps_t * s
-    cap = cohesion + mu * p
-    slipping = abs(t.real) > cap.real
-    if slipping:
-        t = cap if t.real > 0.0 else -cap
+    t, slipping = _return_map(lam_t, eps_t, s, cohesion, mu, p)
     for r in range(10):
         f[r] = -area * p * side * N[r] + area * t * S[r]
     return g, p, t, s, slipping
@@ -460,10 +476,11 @@ def node_to_smooth_segment_friction(x, side, offset, multiplier, penalty, area, 
     Newton solve; zero: the penalty law) returned onto Coulomb's slip surface |t| ≤ c + μ p (c the
     cohesion, μ = tan φ): t = λ_T + ε_T s in stick (|λ_T + ε_T s| ≤ c + μ p), t = (c + μ p) sign(λ_T +
     ε_T s) in slip. The pair's internal force is f = −A p ∂g/∂x + A t ∂s/∂x: in stick the gradient
-    of the energy A⟨λ − εg⟩²/2ε + A (λ_T s + ε_T s²/2) (a symmetric tangent); in slip the traction follows the pressure
-    and the tangent is not symmetric. Both parts are gradients of rotation-invariant scalars
-    weighted by scalars, so the pair conserves linear and angular momentum. The return map moves
-    the stick point at convergence (:func:`slipped_stick_point`). K = ∂f/∂x is the complex-step
+    of the energy A⟨λ − εg⟩²/2ε + A (λ_T s + ε_T s²/2) (a symmetric tangent); in slip the
+    traction follows the pressure and the tangent is not symmetric. Both parts are gradients of
+    rotation-invariant scalars weighted by scalars, so the pair conserves linear and angular
+    momentum. At convergence a slipping slave is attached right under itself
+    (:func:`slipped_stick_point`), its traction kept in λ_T. K = ∂f/∂x is the complex-step
     derivative of f, the projection re-solved in complex arithmetic, stick or slip decided on
     the real parts. (Wriggers, Computational Contact Mechanics, 2nd ed., Springer 2006:
     tangential slip in the master's convected coordinates and Coulomb's law by a return map;
@@ -472,19 +489,12 @@ def node_to_smooth_segment_friction(x, side, offset, multiplier, penalty, area, 
 
     x: (k, 10) current positions (x_s, x_p, x_a, x_b, x_q); side, offset, multiplier λ, penalty ε,
     area A, tangential penalty ε_T, friction coefficient μ, cohesion c, stick points ξ₀ (on each
-    pair's segment curve) and tangential multipliers λ_T: (k,). Returns g, ξ, p, t, s: (k,) (g inf where no closest point was
-    found; p, t zero for open pairs), slipping (k,) bool, f (k, 10), K (k, 10, 10)."""
+    pair's segment curve) and tangential multipliers λ_T: (k,). Returns g, ξ, p, t, s: (k,) (g inf
+    where no closest point was found; p, t zero for open pairs), slipping (k,) bool, f (k, 10),
+    K (k, 10, 10)."""
     k = x.shape[0]
-    g = np.empty(k)
     xi = np.empty(k)
-    p = np.zeros(k)
-    t = np.zeros(k)
-    s = np.zeros(k)
-    slipping = np.zeros(k, dtype=np.bool_)
-    f = np.zeros((k, 10))
-    K = np.zeros((k, 10, 10))
-    xc = np.empty(10, dtype=np.complex128)
-    fc = np.empty(10, dtype=np.complex128)
+    g, p, t, s, slipping, f, K, xc, fc = _friction_arrays(k)
     for i in range(k):
         xii, ok = _closest_on_curve(x[i], _straight_xi(x[i]), 30)
         xi[i] = xii
@@ -561,8 +571,8 @@ def _vertex_friction_force(x, which, nbx, nby, offset, lam, eps, area, eps_t, mu
     r0x = x[0] - (w0[0] * x[2] + w0[1] * x[4] + w0[2] * x[6] + w0[3] * x[8])
     r0y = x[1] - (w0[0] * x[3] + w0[1] * x[5] + w0[2] * x[7] + w0[3] * x[9])
     s = r0x * taux + r0y * tauy
-    # δs = (δx_s − Σ φ_k(ξ₀) δx_k)·τ + (r₀·ν/|x'|) ν·Σ dφ_k δx_k, ν = (τ_y, −τ_x): τ turns with
-    # the nodes
+    # δs = (δx_s − Σ φ_k(ξ₀) δx_k)·τ + (r₀·ν/|x'|) ν·Σ dφ_k δx_k, ν = (τ_y, −τ_x): τ turns
+    # with the nodes
     q = (r0x * tauy - r0y * taux) / la
     S = np.empty(10, dtype=x.dtype)
     S[0] = taux
@@ -570,11 +580,7 @@ def _vertex_friction_force(x, which, nbx, nby, offset, lam, eps, area, eps_t, mu
     for k in range(4):
         S[2 + 2 * k] = -w0[k] * taux + q * dw[k] * tauy
         S[3 + 2 * k] = -w0[k] * tauy - q * dw[k] * taux
-    t = lam_t + eps_t * s
-    cap = cohesion + mu * p
-    slipping = abs(t.real) > cap.real
-    if slipping:
-        t = cap if t.real > 0.0 else -cap
+    t, slipping = _return_map(lam_t, eps_t, s, cohesion, mu, p)
     for r in range(10):
         f[r] = area * t * S[r]
     f[0] -= area * p * sg * dx / dist
@@ -607,15 +613,7 @@ def node_to_vertex_friction(x, which, normal, offset, multiplier, penalty, area,
     penalty, area, eps_t, mu, cohesion, xi0, lam_t: (k,). Returns g, p, t, s (k,), slipping (k,)
     bool, f (k, 10), K (k, 10, 10)."""
     k = x.shape[0]
-    g = np.empty(k)
-    p = np.zeros(k)
-    t = np.zeros(k)
-    s = np.zeros(k)
-    slipping = np.zeros(k, dtype=np.bool_)
-    f = np.zeros((k, 10))
-    K = np.zeros((k, 10, 10))
-    xc = np.empty(10, dtype=np.complex128)
-    fc = np.empty(10, dtype=np.complex128)
+    g, p, t, s, slipping, f, K, xc, fc = _friction_arrays(k)
     for i in range(k):
         g[i], p[i], t[i], s[i], slipping[i] = _vertex_friction_force(
             x[i], which[i], normal[i, 0], normal[i, 1], offset[i], multiplier[i], penalty[i], area[i], eps_t[i],

@@ -11,6 +11,11 @@ import os as _os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
     _os.environ.setdefault(_var, "1")
 
+from .console import announce_compilation, show_compiler_output  # noqa: E402
+
+show_compiler_output(_os.environ.get("DC_COMPILER_OUTPUT", "") not in ("", "0"))
+announce_compilation()
+
 from . import rotations  # noqa: E402
 from .amplitudes import Amplitude
 from .contact.laws import AugmentedLagrangian, ContactError, Coulomb, Penalty
@@ -28,6 +33,6 @@ __version__ = "0.1.0"
 
 __all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "ContactPair",
            "Coulomb", "Penalty", "Circle", "ConvergenceError", "CriticalPoint", "CriticalPointError",
-           "SingularModelError", "Elastic", "GroupNotFoundError", "History", "LoadControl", "MeshError", "NeoHookean",
+           "SingularModelError", "Elastic", "show_compiler_output", "GroupNotFoundError", "History", "LoadControl", "MeshError", "NeoHookean",
            "NewtonOptions", "Pipe", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh",
            "from_gmsh", "rotations", "solve"]

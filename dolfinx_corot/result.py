@@ -41,6 +41,44 @@ class History:
             return out
         return np.array([r.get(name, np.nan) for r in self.rows], dtype=float)
 
+    def to_pandas(self):
+        """The history as a :class:`pandas.DataFrame`, one row per step, indexed by step (needs
+        pandas); the ``residuals`` column holds each step's residual norms as an array."""
+        try:
+            import pandas
+        except ImportError:
+            raise ImportError("History.to_pandas needs pandas (Debian: apt install python3-pandas; "
+                              "or pip install pandas)") from None
+        frame = pandas.DataFrame({name: (list(self.column(name)) if name == "residuals" else self.column(name))
+                                  for name in self.columns})
+        if "step" in frame:
+            frame["step"] = frame["step"].astype(int)
+            frame = frame.set_index("step")
+        return frame
+
+    @classmethod
+    def read_csv(cls, path: str) -> "History":
+        """The history written by :meth:`to_csv` (or :meth:`Result.write`): numbers as floats,
+        ``step``, ``iterations`` and ``cuts`` as integers, ``residuals`` as its text."""
+        rows = []
+        with open(path, newline="") as f:
+            for raw in csv.DictReader(f):
+                row = {}
+                for key, text in raw.items():
+                    if text is None or text == "":
+                        continue
+                    if key == "residuals":
+                        row[key] = text
+                    elif key in ("step", "iterations", "cuts"):
+                        row[key] = int(float(text))
+                    else:
+                        try:
+                            row[key] = float(text)
+                        except ValueError:
+                            row[key] = text
+                rows.append(row)
+        return cls(rows)
+
     def to_csv(self, path: str) -> None:
         os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
         cols = self.columns
@@ -145,6 +183,22 @@ class Result:
     totals: dict = field(default_factory=dict)
     profiles: dict = field(default_factory=dict)
     critical_points: list = field(default_factory=list)  # CriticalPoint: limit points, bifurcations
+    monitors: dict = field(default_factory=dict)  # monitor name → its history columns
+
+    def monitor(self, name: str):
+        """The values of monitor ``name`` step by step: a dict {dof or component: (steps,) array}
+        (``{"ux": …, "uy": …, "rz": …}`` for a point; ``"uy_absmax"`` for a reduction; ``"Fx"`` …
+        for a reaction; the contact columns of ``scene.monitor_contact``), or the
+        :class:`Profile` of a profile monitor."""
+        if name in self.profiles:
+            return self.profiles[name]
+        columns = self.monitors.get(name)
+        if columns is None:  # a history read back or restarted: the columns named after the monitor
+            columns = [c for c in self.history.columns if c.startswith(f"{name}_")]
+        if not columns:
+            known = sorted(set(self.monitors) | set(self.profiles))
+            raise KeyError(f"no monitor '{name}' in this result; monitors: {known}")
+        return {c[len(name) + 1:]: self.history.column(c) for c in columns}
 
     def write(self, directory: str, name: str = "history") -> str:
         """Write ``<directory>/<name>.csv``, a JSON summary and, with profiles,

@@ -517,8 +517,13 @@ class Scene:
     def monitor_values(self, system) -> dict[str, float]:
         """Monitored dofs (one node, or a reduction over a group) and reactions at the current state
         (``system`` holds f_int), by history column."""
-        values = {}
+        return {col: v for values in self.monitor_values_by_name(system).values() for col, v in values.items()}
+
+    def monitor_values_by_name(self, system) -> dict[str, dict[str, float]]:
+        """:meth:`monitor_values` monitor by monitor: name → {history column: value}."""
+        out = {}
         for mon in self.monitors:
+            values = out.setdefault(mon.name, {})
             if mon.kind == "contact":  # part: the ContactPair, where: its side
                 values.update(mon.part.monitor_values(mon.name, mon.where))
                 continue
@@ -536,7 +541,7 @@ class Scene:
                 suffix = "" if mon.reduce is None else f"_{mon.reduce}"
                 for comp, val in zip(model.dof_names, reduced):
                     values[f"{mon.name}_{comp}{suffix}"] = float(val)
-        return values
+        return out
 
     def _group(self, mon: Monitor):
         """The node group of a monitor (found once: a group's nodes do not change)."""

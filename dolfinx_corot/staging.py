@@ -121,7 +121,8 @@ class K0:
 
 
 def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: Sequence = (),
-                 on_step=None, checkpoint: str | None = None, restart: str | None = None) -> list[Result]:
+                 on_step=None, checkpoint: str | None = None, restart: str | None = None, progress=None,
+                 quiet: bool = False) -> list[Result]:
     """Run ``stages`` in turn on ``scene``; ``initial`` = [(solid part, cell group), …] exist from
     the start (the rest of each staged solid does not, until a stage adds it). ``on_step(stage,
     row)`` is called after every converged step with the :class:`Stage` and the step's history
@@ -142,7 +143,8 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
     gaps and the results of the stages before. restart: such a file; the run goes on in the stage
     and at the step it holds, with the same scene, approach and stages up to that one (later
     stages may differ; the stage reached may be given another driver of its kind, e.g. smaller
-    steps after a failure, see the drivers' ``run``), and reproduces the uninterrupted run."""
+    steps after a failure, see the drivers' ``run``), and reproduces the uninterrupted run.
+    progress, quiet: as for :func:`~dolfinx_corot.solve`, each stage named in its lines."""
     if approach not in APPROACHES:
         raise ValueError(f"solve_stages: approach = {approach!r} is not one of {APPROACHES}")
     models = scene.model.models if scene.model.coupled else [scene.model]
@@ -261,7 +263,8 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
             try:
                 step = None if on_step is None else (lambda row, stage=stage: on_step(stage, row))
                 result = solve(scene, stage.driver, system=system, on_step=step, checkpoint=checkpoint,
-                               restart=restart if resuming else None, attach=attach)
+                               restart=restart if resuming else None, attach=attach, progress=progress,
+                               quiet=quiet, label=f"stage {index + 1}/{len(stages)} '{stage.name}'")
             except ConvergenceError as err:
                 err.result.mappings = mappings
                 err.results = results + [err.result]

@@ -3,7 +3,7 @@
 #
 #  1. Debian packages: DOLFINx 0.5.2 (PETSc 3.18, MUMPS), gmsh, meshio, h5py,
 #     OpenBLAS (MUMPS is ~3x slower with the reference BLAS), EGL for
-#     off-screen PyVista, matplotlib, scipy.
+#     off-screen PyVista, matplotlib, scipy, pandas (Result.history.to_pandas).
 #  2. .venv made by Debian's /usr/bin/python3 with --system-site-packages, so
 #     that it sees dolfinx; numpy & friends are pinned to Debian's versions by
 #     a constraints file that every pip call in the venv obeys (.venv/pip.conf).
@@ -19,7 +19,7 @@ stamp="$venv/.dolfinx_corot-setup"
 
 debs=(python3-dolfinx-real python3-gmsh python3-meshio python3-venv python3-h5py
       python3-matplotlib python3-scipy python3-dev libopenblas0-pthread
-      libegl1 libegl-mesa0 openmpi-bin)
+      python3-pandas libegl1 libegl-mesa0 openmpi-bin)
 pip_pkgs=(numba pyvista tqdm pytest hypothesis)
 
 # What the stamp must match: this script and the package metadata.
@@ -51,7 +51,7 @@ fi
 /usr/bin/python3 - "$venv/constraints.txt" <<'EOF'
 import importlib, sys
 mods = {"numpy": "numpy", "scipy": "scipy", "matplotlib": "matplotlib", "mpi4py": "mpi4py",
-        "petsc4py": "petsc4py", "h5py": "h5py", "cffi": "cffi"}
+        "petsc4py": "petsc4py", "h5py": "h5py", "cffi": "cffi", "pandas": "pandas"}
 lines = []
 for dist, mod in mods.items():
     lines.append(f"{dist}=={importlib.import_module(mod).__version__}")

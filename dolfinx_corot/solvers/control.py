@@ -134,8 +134,10 @@ class LoadControl:
         tracker = StabilityTracker(system, self.stability)
         if run.history.rows and "negative_eigenvalues" in run.history.rows[-1]:
             tracker.negative = int(run.history.rows[-1]["negative_eigenvalues"])
+        run.expect(len(targets), start)
         for index in range(start, len(targets)):
             target = targets[index]
+            origin = lam
             cuts = 0
             retried = check_iterations = 0
             while abs(target - lam) > 1e-14 * max(1.0, abs(target)):
@@ -209,8 +211,9 @@ class LoadControl:
                     self._critical_point(run, tracker, cp, previous, lam, trial, before, after, passed)
                 previous = (lam, cp)
                 lam = trial
-                run.record(lam, report, cuts, started, extra)
                 reached = abs(target - lam) <= 1e-14 * max(1.0, abs(target))
+                run.record(lam, report, cuts, started, extra,
+                           position=index + (1.0 if reached else (lam - origin) / (target - origin)))
                 run.save({**self.describe(), "next_target": index + 1 if reached else index})
                 cuts = max(cuts - 1, 0)
         return run.result()
@@ -490,6 +493,8 @@ class ArcLength:
             dlam_prev, have_prev = state["dlam_prev"], state["have_prev"]
             lam = run.load_factor
             system.global_to_vector(arrays, "Dx_prev", Dx_prev)
+        run.expect(self.max_steps, run.step)
+        reached = float(run.step)
         while run.step < self.max_steps:
             cp = system.checkpoint()
             started = run.begin()
@@ -567,7 +572,10 @@ class ArcLength:
             extra = {"arc_length": arc}
             if after is not None:
                 extra["negative_eigenvalues"] = after
-            row = run.record(lam, report, cuts, started, extra)
+            if math.isfinite(self.max_load_factor):  # the steps or the load factor, whichever is further
+                reached = max(reached, self.max_steps * abs(lam) / self.max_load_factor)
+            reached = max(reached, run.step + 1.0)
+            row = run.record(lam, report, cuts, started, extra, position=reached)
             cuts = 0
             factor = math.sqrt(self.desired_iterations / max(report.iterations, 1))
             arc = min(max(arc * min(max(factor, 0.5), self.max_growth), arc_min), arc_max)

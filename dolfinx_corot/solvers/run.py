@@ -25,6 +25,7 @@ import numpy as np
 from ..assembly import System, make_system
 from ..result import History, Profile, Result
 from .newton import ConvergenceError, NewtonReport
+from .progress import Progress, progress_mode
 
 logger = logging.getLogger(__name__)
 
@@ -96,8 +97,10 @@ def read_checkpoint_on_all_ranks(path: str, comm) -> tuple[dict, dict]:
 class Run:
     """Bookkeeping shared by the drivers: history rows, totals, failure, checkpoints."""
 
-    def __init__(self, scene, system: System, on_step, checkpoint: str | None = None, attach=None):
+    def __init__(self, scene, system: System, on_step, checkpoint: str | None = None, attach=None,
+                 progress: Progress | None = None):
         self.scene = scene
+        self.progress = Progress("off", system.comm) if progress is None else progress
         # (meta, arrays) written with every checkpoint by the run that holds this one (a staged
         # run: the stage and what the stages before it left; ({}, None) without a checkpoint);
         # arrays on rank 0
@@ -107,6 +110,7 @@ class Run:
         self.checkpoint_path = checkpoint
         self.history = History()
         self.profiles: dict[str, Profile] = scene.profiles()
+        self.monitor_columns: dict[str, list[str]] = {}  # monitor → its history columns
         self.t_start = time.perf_counter()
         self.cuts = 0
         self.iterations = 0
@@ -135,7 +139,10 @@ class Run:
     def begin(self):
         return time.perf_counter(), self.system.timings.copy()
 
-    def record(self, lam: float, report: NewtonReport, cuts: int, started, extra: dict | None = None) -> dict:
+    def record(self, lam: float, report: NewtonReport, cuts: int, started, extra: dict | None = None,
+               position: float | None = None) -> dict:
+        """Commit the converged step and add its history row (``position``: where the run is,
+        for its progress, in the measure given to :meth:`expect`)."""
         t0, tm0 = started
         tm = self.system.timings
         self.load_factor = lam
@@ -149,15 +156,24 @@ class Run:
                "residuals": " ".join(f"{r:.2e}" for r in report.residuals)}
         row.update(self.system.history(report))
         row.update(extra or {})
-        row.update(self.scene.monitor_values(self.system))
+        for name, values in self.scene.monitor_values_by_name(self.system).items():
+            row.update(values)
+            known = self.monitor_columns.setdefault(name, [])
+            known += [c for c in values if c not in known]
         self.history.append(row)
         for name, values in self.scene.profile_values().items():
             self.profiles[name].append(self.step, lam, values)
         logger.info("step %d: lambda = %.6g, %d iterations, |r|: %s", self.step, lam, report.iterations,
                     row["residuals"])
+        self.progress.step(row, position)
         if self.on_step is not None:
             self.on_step(row)
         return row
+
+    def expect(self, total: float | None, done: float = 0.0) -> None:
+        """The run's length in the driver's measure (its targets, steps; None: unknown) and how much
+        of it was done before a restart, for the progress shown."""
+        self.progress.expect(total, done)
 
     def save(self, driver_state: dict, vectors: dict | None = None) -> None:
         """Write the checkpoint (if asked for): configuration, contribution states, history,
@@ -239,10 +255,14 @@ class Run:
                 "wall_time": time.perf_counter() - self.t_start}
 
     def fail(self, msg: str, error=ConvergenceError):
-        raise error(msg, Result(self.history, False, msg, self.totals(), self.profiles, list(self.critical_points)))
+        self.progress.close(msg)
+        raise error(msg, Result(self.history, False, msg, self.totals(), self.profiles, list(self.critical_points),
+                                dict(self.monitor_columns)))
 
     def result(self, message: str = "") -> Result:
-        return Result(self.history, True, message, self.totals(), self.profiles, list(self.critical_points))
+        self.progress.close()
+        return Result(self.history, True, message, self.totals(), self.profiles, list(self.critical_points),
+                      dict(self.monitor_columns))
 
     # -- plausibility ---------------------------------------------------------------------
     def model_size(self) -> float:
@@ -270,7 +290,8 @@ class Run:
 
 
 def solve(scene, driver, system: System | None = None, on_step=None, checkpoint: str | None = None,
-          restart: str | None = None, attach=None) -> Result:
+          restart: str | None = None, attach=None, progress=None, quiet: bool = False,
+          label: str = "") -> Result:
     """Run ``driver`` (LoadControl or ArcLength) on ``scene``; returns a :class:`Result`.
 
     On a step that fails after all cuts, raises :class:`ConvergenceError`
@@ -286,13 +307,23 @@ def solve(scene, driver, system: System | None = None, on_step=None, checkpoint:
     (a larger ``final`` or ``max_steps``): see each driver's ``run``. A restarted run
     reproduces the uninterrupted one. attach: (meta, arrays on rank 0) written into every
     checkpoint besides (:func:`dolfinx_corot.staging.solve_stages` keeps its stage there).
+
+    progress: how the run reports its steps on standard output (rank 0): 'auto' (default: a
+    bar on a terminal, one line per step otherwise), 'bar', 'lines' or 'off'; ``quiet=True``
+    is 'off'; the environment variable ``DC_PROGRESS`` sets the default
+    (:mod:`~dolfinx_corot.solvers.progress`). label: the run's name in those lines.
     """
+    mode = progress_mode(progress, quiet)
     own_system = system is None
     if own_system:
         system = make_system(scene.model, solver=scene.linear_solver,
                              contributions=scene.contributions())
+    shown = Progress(mode, system.comm, label)
     try:
-        return driver.run(Run(scene, system, on_step, checkpoint, attach), restart)
+        return driver.run(Run(scene, system, on_step, checkpoint, attach, shown), restart)
+    except BaseException as err:
+        shown.close(type(err).__name__)
+        raise
     finally:
         if own_system:
             system.destroy()

@@ -64,6 +64,7 @@ def rollup(demo):
     scene.monitor("tip", strip, "tip")
 
     shapes = {}
+    pictures = dc.plot.Snapshots(scene, at=(0.25, 0.5, 1.0, 1.5, 2.0))  # PyVista states
 
     def snapshot(row):
         lf = row["load_factor"]
@@ -71,12 +72,14 @@ def rollup(demo):
             X, state = scene.model.nodes()
             order = np.argsort(X[:, 0])
             shapes[round(lf, 3)] = (X + state[:, :2])[order]
+        pictures(row)
 
     steps = 40  # 20 steps per turn: 18 degrees of tip rotation per step
     result, wall = timed(dc.solve, scene, dc.LoadControl(steps=steps, final=2.0), on_step=snapshot)
     demo.write_result(result)
     demo.say(f"{len(result.history)} steps, {result.totals['newton_iterations']} Newton iterations, "
              f"{result.totals['cuts']} cuts, {wall:.2f} s")
+    demo.picture(pictures, "rollup_shapes.png", field="rotation", title="M = 0.25, 0.5, 1, 1.5, 2 × 2πEI/L")
     return result.history, shapes
 
 

@@ -11,12 +11,17 @@ import os as _os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
     _os.environ.setdefault(_var, "1")
 
+try:  # VTK's C++ runtime before numba's: llvmlite's exported std::string symbols otherwise take
+    import vtkmodules.vtkCommonCore  # noqa: F401,E402  (over VTK's and crash its std::regex: pictures)
+except ImportError:  # no PyVista: no pictures
+    pass
+
 from .console import announce_compilation, show_compiler_output  # noqa: E402
 
 show_compiler_output(_os.environ.get("DC_COMPILER_OUTPUT", "") not in ("", "0"))
 announce_compilation()
 
-from . import rotations  # noqa: E402
+from . import plot, rotations  # noqa: E402
 from .amplitudes import Amplitude
 from .contact.laws import AugmentedLagrangian, ContactError, Coulomb, Penalty
 from .contact.pair import ContactPair
@@ -35,4 +40,4 @@ __all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "
            "Coulomb", "Penalty", "Circle", "ConvergenceError", "CriticalPoint", "CriticalPointError",
            "SingularModelError", "Elastic", "show_compiler_output", "GroupNotFoundError", "History", "LoadControl", "MeshError", "NeoHookean",
            "NewtonOptions", "Pipe", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh",
-           "from_gmsh", "rotations", "solve"]
+           "from_gmsh", "plot", "rotations", "solve"]

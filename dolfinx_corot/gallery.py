@@ -11,6 +11,7 @@ A demo is a narrated script whose computation lives in ``main() -> dict``::
         fig, ax = demo.figure(1, 2, figsize=(11, 4))      # a matplotlib figure
         ...
         demo.save(fig, "euler_beam_2d.png")               # the PNG, on rank 0
+        demo.picture(shots, "euler_beam_2d_shapes.png")   # a PyVista picture (dolfinx_corot.plot)
         demo.record(load_factor=lam, ux=ux)               # tip_values.json
         demo.check("tip error", err, bound=2e-4, reference="B1 exact elastica")
         return demo.finish()                              # "<name>: verified"
@@ -23,7 +24,8 @@ A demo is a narrated script whose computation lives in ``main() -> dict``::
 Each :meth:`Demo.check` asserts one number against a *named* reference and
 keeps the verification; :meth:`Demo.finish` returns them with the recorded
 values as ``{"name", "checks", "values"}``, which the test-suite inspects
-(``tests/test_demos.py``), and writes them to ``verification.json``.
+(``tests/test_demos.py``), and writes them to ``verification.json``, with the PyVista pictures
+written by :meth:`Demo.picture`.
 
 The recorded values (:meth:`Demo.record`) are the numbers that a run under
 ``mpirun -n 2`` must reproduce: they go to ``<out>/tip_values.json`` with
@@ -93,6 +95,7 @@ class Demo:
         self.ci = os.environ.get("CI") == "true"
         self.checks: list[dict] = []
         self.values: dict[str, Any] = {}
+        self.pictures: list[str] = []
 
     def say(self, *args: Any) -> None:
         """``print(*args)`` on rank 0, flushed."""
@@ -127,6 +130,18 @@ class Demo:
         if self.rank == 0:
             fig.tight_layout()
             fig.savefig(self.path(filename), dpi=dpi)
+
+    def picture(self, states, filename: str, **options) -> None:
+        """A PyVista picture of the deformed parts, ``<out>/<filename>``: ``states`` is a
+        :class:`dolfinx_corot.plot.Snapshots` (its kept states), a list of
+        :class:`~dolfinx_corot.plot.State`, or a scene (its current state; collective). Options:
+        those of :func:`dolfinx_corot.plot.picture` (field, scale, layout, title, camera, …)."""
+        from . import plot
+
+        if isinstance(states, plot.Snapshots):
+            states = states.states
+        plot.picture(states, self.path(filename), **options)
+        self.pictures.append(filename)
 
     def table(self, filename: str, rows: Union[Sequence[dict], np.ndarray],
               columns: Optional[Sequence[str]] = None) -> None:
@@ -203,7 +218,8 @@ class Demo:
         failed = [c["label"] for c in self.checks if not c["passed"]]
         if failed:
             raise VerificationError(f"{self.name}: failed checks: {'; '.join(failed)}")
-        report = {"name": self.name, "checks": list(self.checks), "values": dict(self.values)}
+        report = {"name": self.name, "checks": list(self.checks), "values": dict(self.values),
+                  "pictures": list(self.pictures)}
         if self.rank == 0:
             with open(self.path("verification.json"), "w") as f:
                 json.dump({**report, "ranks": self.comm.size}, f, indent=1)

@@ -452,6 +452,13 @@ class Part:
         owned cell, u (cells, vertices, gdim) their displacement, exists (cells,) whether the cell
         has an existing element), on every rank, rank by rank. Quadrilateral vertices in the
         order of their outline."""
+        X, u, exists, _ = self._owned_cell_drawing()
+        gather = (lambda a: np.concatenate(self.comm.allgather(a)))
+        return gather(X), gather(u), gather(exists)
+
+    def _owned_cell_drawing(self) -> tuple:
+        """(X, u, exists, blocks) of the owned cells (see :meth:`cell_shapes`), blocks
+        (cells, vertices) their vertices' blocks."""
         mesh = self.V.mesh
         tdim = mesh.topology.dim
         nv = {"interval": 2, "triangle": 3, "quadrilateral": 4, "tetrahedron": 4,
@@ -463,8 +470,32 @@ class Part:
         X = self.V.tabulate_dof_coordinates()[:, : self.gdim][blocks]
         u = self.state.x.array.reshape(-1, self.state_size)[:, : self.gdim][blocks]
         exists = (self.cells_existing() if self.is_staged() else self._cells_active())[:n_owned]
-        gather = (lambda a: np.concatenate(self.comm.allgather(a)))
-        return gather(X), gather(u), gather(exists)
+        return X, u, exists, blocks
+
+    def drawing(self, root: int = 0) -> dict | None:
+        """What a picture of the part needs (:mod:`dolfinx_corot.plot`), gathered on rank ``root``
+        (None on the other ranks): ``cell`` (the cell name), ``gdim``, ``X`` (cells, vertices, gdim)
+        the initial positions of the vertices of every cell, ``u`` their displacements, ``exists``
+        (cells,), ``rotation`` (cells, vertices) the magnitude of the nodal rotations (None for a
+        part without rotations) and ``size`` (cells,) the drawn size of each cell (a beam's radius, a
+        shell's thickness; None for solids). Collective."""
+        X, u, exists, blocks = self._owned_cell_drawing()
+        rotation = None
+        if self.ndof > self.translations:
+            values = self._rotation_values()
+            rotation = np.linalg.norm(values.reshape(len(values), -1), axis=1)[blocks]
+        n_owned = len(X)
+        size = self._drawn_sizes(np.arange(n_owned, dtype=np.int32))
+        parts = self.comm.gather((X, u, exists, rotation, size), root=root)
+        if parts is None:
+            return None
+        join = (lambda k: None if parts[0][k] is None else np.concatenate([p[k] for p in parts]))
+        return {"cell": self.V.mesh.topology.cell_name(), "gdim": self.gdim, "X": join(0), "u": join(1),
+                "exists": join(2), "rotation": join(3), "size": join(4), "kind": self.kind_name}
+
+    def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray | None:
+        """The drawn size of the given owned cells (see :meth:`drawing`); None: none."""
+        return None
 
     def surface(self, where: str, body: str | None = None) -> Surface:
         """The contact surface of group ``where`` (parts that have none refuse); ``body``: the

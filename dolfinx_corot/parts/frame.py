@@ -375,6 +375,12 @@ class Frame2D(AdditiveState, LineFrame):
         law2d.check_props(EA, EI, GAs, f"{kind} '{where}'")
         return self.add_elements(where, np.array([EA, EI, GAs, N0]), EI > 0.0, kind)
 
+    def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray:
+        """Half the section's depth √(12 EI/EA)/2 (exact for rectangles; 0 for bars)."""
+        props = self.cell_properties(cells)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(props[:, 0] > 0.0, 0.5 * np.sqrt(12.0 * props[:, 1] / props[:, 0]), 0.0)
+
     def element_forces(self) -> tuple[np.ndarray, np.ndarray]:
         """(cells, forces): the owned cells with existing elements and their end forces and
         moments (n, 6) in global axes, (Fx, Fy, M) at node 1 then node 2 — the forces the element
@@ -521,6 +527,10 @@ class Frame3D(Rotations3D, LineFrame):
             raise SurfaceError(f"contact surface '{where}': some of its lines carry no beam")
         return gather_surface(self, where, seg_blocks, self.V.tabulate_dof_coordinates(),
                               offsets=self._contact_radius[cells], two_sided=True, modulus=None, cells=cells)
+
+    def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray:
+        """The section's contact radius (a pipe's or a circle's outer radius, a rectangle's half depth)."""
+        return self._contact_radius[cells]
 
     def _check_geometry(self, cells, label, props):
         super()._check_geometry(cells, label, props)

@@ -75,6 +75,11 @@ class Surface3D(Rotations3D, LineFrame):
                               two_sided=True, modulus=modulus, cells=cells)
 
 
+    def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray:
+        """The thickness."""
+        return self.cell_properties(cells)[:, 2]
+
+
 class Shell3D(Surface3D):
     """Flat co-rotational shell triangles on a triangle mesh in space; dofs (ux, uy, uz, rx, ry, rz)
     per node, rotations multiplicative as in :class:`Frame3D`."""

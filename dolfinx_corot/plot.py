@@ -1,0 +1,285 @@
+"""Pictures of a scene with PyVista, off screen: the deformed parts at several load levels over
+their undeformed outline, coloured by a field.
+
+One call draws the current state of a scene::
+
+    dc.plot.picture(scene, "bend.png")                       # |u| on the deformed shape
+
+and a :class:`Snapshots` recorder keeps states along a run to draw them side by side (or on
+top of one another for frames)::
+
+    shots = dc.plot.Snapshots(scene, at=(0.25, 0.5, 1.0))    # the first steps at or past these λ
+    result = dc.solve(scene, driver, on_step=shots)
+    shots.picture("bend_steps.png", field="rotation")
+
+Every part kind is drawn: beams and bars as tubes of their section's radius (lines in a plane
+for 2D scenes), shells and membranes as surfaces, solids by their boundary faces; cells that do
+not exist in a stage are left out. Fields: ``"displacement"`` (|u|), ``"rotation"`` (|θ| of
+the nodal rotations, zero for parts without them), or ``"none"`` (one colour per part). The
+undeformed shape is drawn in grey, the camera looks along z for 2D scenes and isometrically in
+3D, and the colour range is shared by every state of a picture.
+
+Capturing is collective (every rank calls it: the cells are gathered on rank 0); drawing
+happens on rank 0 only. PyVista renders without a display through EGL (Debian's libegl1
+and libegl-mesa0, installed by the set-up).
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field as dataclass_field
+from typing import Sequence
+
+import numpy as np
+from mpi4py import MPI
+
+__all__ = ["Snapshots", "State", "capture", "grid_of", "picture"]
+
+FIELDS = {"displacement": "displacement", "rotation": "rotation (rad)", "none": None}
+LINE_CELLS = ("interval",)
+VTK_CELLS = {"interval": 3, "triangle": 5, "quadrilateral": 9, "tetrahedron": 10, "hexahedron": 12}
+
+
+@dataclass
+class State:
+    """The drawing of every part of a scene at one moment (on rank 0; ``parts`` is empty on the
+    others): ``label`` titles it, ``load_factor`` is where it was taken."""
+
+    label: str
+    load_factor: float | None
+    parts: list = dataclass_field(default_factory=list)
+
+
+def capture(scene, label: str = "", load_factor: float | None = None) -> State:
+    """The current state of ``scene`` (collective)."""
+    models = scene.model.models if scene.model.coupled else [scene.model]
+    drawings = [m.drawing() for m in models]
+    return State(label, load_factor, [d for d in drawings if d is not None])
+
+
+class Snapshots:
+    """Keeps states of a scene along a run; use it as ``on_step`` of :func:`dolfinx_corot.solve`
+    (a row argument) or of :func:`dolfinx_corot.staging.solve_stages` (stage, row).
+
+    at: load factors: the first converged step at or past each (in absolute value) is kept;
+    every: keep every ``every``-th step; neither: keep the last step of each run or stage only
+    (call :meth:`take` to keep others). :meth:`take` keeps the current state under a label.
+    """
+
+    def __init__(self, scene, at: Sequence[float] | None = None, every: int | None = None):
+        self.scene = scene
+        self.at = None if at is None else sorted(abs(float(a)) for a in at)
+        self.every = every
+        self.states: list[State] = []
+        self._next = 0
+        self._step = 0
+        self._pending: tuple | None = None  # (stage name, row) of the last step, if not yet kept
+
+    def __call__(self, *args) -> None:
+        stage, row = (None, args[0]) if len(args) == 1 else args
+        self._step += 1
+        lam = float(row["load_factor"])
+        name = f"{stage.name}: " if stage is not None else ""
+        keep = False
+        if self.at is not None:
+            while self._next < len(self.at) and abs(lam) >= self.at[self._next] * (1 - 1e-12):
+                self._next += 1
+                keep = True
+        elif self.every is not None:
+            keep = self._step % self.every == 0
+        if keep:
+            self.states.append(capture(self.scene, f"{name}λ = {lam:.3g}", lam))
+
+    def take(self, label: str, load_factor: float | None = None) -> State:
+        """Keep the current state under ``label`` (collective)."""
+        state = capture(self.scene, label, load_factor)
+        self.states.append(state)
+        return state
+
+    def picture(self, filename: str, **options) -> str | None:
+        """:func:`picture` of the kept states (see there for ``options``)."""
+        if not self.states:
+            raise ValueError("Snapshots.picture: no state was kept (give `at` or `every`, or call take())")
+        return picture(self.states, filename, **options)
+
+
+def _pyvista():
+    """PyVista set for off-screen rendering (EGL where there is no display)."""
+    if not os.environ.get("DISPLAY"):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    import pyvista
+
+    pyvista.OFF_SCREEN = True
+    return pyvista
+
+
+def grid_of(part: dict, field: str = "displacement", deformed: bool = True, scale: float = 1.0):
+    """The PyVista grid of one part of a :class:`State` (its existing cells, one point per node,
+    on the deformed shape unless ``deformed=False``) with the point field ``field`` (see
+    :func:`picture`) as ``point_data["field"]``."""
+    return _grid(_pyvista(), part, deformed, scale, field)
+
+
+def _font() -> str | None:
+    """A font with Greek letters (DejaVu Sans, found by matplotlib), or None: VTK's own."""
+    try:
+        from matplotlib import font_manager
+
+        return font_manager.findfont("DejaVu Sans", fallback_to_default=False)
+    except (ImportError, ValueError):
+        return None
+
+
+def _use_font(prop, font: str | None) -> None:
+    """Set a VTK text property to the font file ``font``."""
+    if font:
+        prop.SetFontFamily(4)  # VTK_FONT_FILE
+        prop.SetFontFile(font)
+
+
+def _grid(pv, part: dict, deformed: bool, scale: float, field: str):
+    """The PyVista dataset of one part (existing cells only) and its point field (or None)."""
+    keep = np.asarray(part["exists"], dtype=bool)
+    X, u = part["X"][keep], part["u"][keep]
+    ncells, nv, gdim = X.shape
+    # one point per node: the cells' vertices merged where both position and displacement agree
+    # (bodies meshed apart that start in contact keep their own nodes)
+    key = np.concatenate([X, u], axis=2).reshape(-1, 2 * gdim)
+    unique, first, connectivity = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    connectivity = connectivity.reshape(ncells, nv)
+    points = (unique[:, :gdim] + scale * unique[:, gdim:]) if deformed else unique[:, :gdim]
+    if gdim == 2:
+        points = np.column_stack([points, np.zeros(len(points))])
+    cells = np.column_stack([np.full(ncells, nv), connectivity]).ravel()
+    grid = pv.UnstructuredGrid(cells, np.full(ncells, VTK_CELLS[part["cell"]], dtype=np.uint8), points)
+    u_nodes = unique[:, gdim:]
+    values = None
+    if field == "displacement":
+        values = np.linalg.norm(u_nodes, axis=1)
+    elif field == "rotation":
+        rot = part["rotation"]
+        values = np.zeros(len(unique)) if rot is None else rot[keep].ravel()[first]
+    if values is not None:
+        grid.point_data["field"] = values
+    if part["size"] is not None:
+        grid.cell_data["size"] = np.asarray(part["size"])[keep]
+    return grid
+
+
+def _shape(pv, grid, cell: str, gdim: int, length: float, outline: bool):
+    """What is drawn of a part's grid: tubes for lines in 3D, lines in 2D, the boundary of a solid."""
+    if cell in LINE_CELLS:
+        lines = grid.extract_surface(algorithm=None)
+        if gdim == 3 and not outline and grid.n_cells:
+            size = grid.cell_data.get("size")
+            radius = float(np.median(size)) if size is not None and np.any(size > 0) else 0.0
+            radius = min(max(radius, 2e-3 * length), 0.02 * length)
+            return lines.tube(radius=radius, n_sides=12), {}
+        return lines, {"line_width": 1.5 if outline else 4.0}
+    surface = grid.extract_surface(algorithm=None)
+    if outline:
+        return surface.extract_feature_edges(boundary_edges=True, feature_edges=cell in ("tetrahedron",
+                                                                                         "hexahedron"),
+                                             manifold_edges=False, non_manifold_edges=False), {"line_width": 1.0}
+    return surface, {}
+
+
+def picture(states, filename: str, *, field: str = "displacement", scale: float = 1.0,
+            layout: str = "auto", title: str | None = None, undeformed: bool = True,
+            window_size: tuple = (1400, 800), camera: str | None = None, show_edges: bool | None = None,
+            columns: int = 3, clim: tuple | None = None) -> str | None:
+    """Draw ``states`` (a :class:`State`, a list of them, or a scene: its current state) into the
+    PNG ``filename``; returns the path on rank 0, None on the others (collective when given a
+    scene, which is captured first).
+
+    field: 'displacement' (|u|), 'rotation' (|θ|) or 'none'; scale: displacement magnification;
+    layout: 'overlay' (every state in one view: frames), 'grid' (one view each, ``columns`` per
+    row), 'auto' (overlay when every part is made of lines, else grid); undeformed: the initial
+    shape in grey (a thin outline of surfaces and solids); camera: 'xy' (2D scenes' default),
+    'iso' (3D default) or a PyVista camera position; show_edges: the cells' edges on surfaces
+    (default: with fewer than 5000 cells); clim: the colour range (default: from 0 to the
+    largest value over the states).
+    """
+    if field not in FIELDS:
+        raise ValueError(f"picture: field '{field}' is not one of {list(FIELDS)}")
+    if layout not in ("auto", "overlay", "grid"):
+        raise ValueError(f"picture: layout '{layout}' is not one of ['auto', 'overlay', 'grid']")
+    if not isinstance(states, (State, list, tuple)):
+        states = capture(states, title or "")
+    states = [states] if isinstance(states, State) else list(states)
+    if MPI.COMM_WORLD.rank != 0:
+        return None
+    if not states or not states[0].parts:
+        raise ValueError("picture: nothing to draw (no state, or a state without parts)")
+    pv = _pyvista()
+    gdim = states[0].parts[0]["gdim"]
+    lines_only = all(p["cell"] in LINE_CELLS for s in states for p in s.parts)
+    if layout == "auto":
+        layout = "overlay" if lines_only else "grid"
+    views = [states] if layout == "overlay" else [[s] for s in states]
+    ncols = min(columns, len(views))
+    nrows = -(-len(views) // ncols)
+    # sizes and colour range over every state
+    corners = np.concatenate([np.concatenate([(p["X"] + scale * p["u"]).reshape(-1, gdim), p["X"].reshape(-1, gdim)])
+                              for s in states for p in s.parts if len(p["X"])])
+    length = float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0))) or 1.0
+    grids = [[(_grid(pv, p, True, scale, field), p) for p in s.parts] for s in states]
+    if clim is None and field != "none":
+        top = max((float(g.point_data["field"].max()) for gs in grids for g, _ in gs if g.n_points), default=0.0)
+        clim = (0.0, top if top > 0.0 else 1.0)
+    ncells = sum(len(p["X"]) for p in states[0].parts)
+    edges = (ncells < 5000) if show_edges is None else show_edges
+    plotter = pv.Plotter(off_screen=True, shape=(nrows, ncols), window_size=window_size, border=False)
+    colours = ["#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860"]
+    bar = None if field == "none" else dict(
+        title=FIELDS[field] + (f" (×{scale:g})" if scale != 1.0 and field == "displacement" else ""), n_labels=4,
+        fmt="%.3g", color="black", vertical=True, position_x=0.88 if ncols == 1 else 0.8, position_y=0.2,
+        width=0.06 if ncols == 1 else 0.15, height=0.6, title_font_size=18, label_font_size=14)
+    font = _font()
+    index = {id(s): i for i, s in enumerate(states)}
+    mapper = None
+    for k, view in enumerate(views):
+        plotter.subplot(k // ncols, k % ncols)
+        for s in view:
+            for j, (grid, part) in enumerate(grids[index[id(s)]]):
+                if not grid.n_cells:
+                    continue
+                if undeformed and (s is view[0]):
+                    base = _grid(pv, part, False, scale, "none")
+                    shape, style = _shape(pv, base, part["cell"], gdim, length, outline=part["cell"] not in LINE_CELLS)
+                    plotter.add_mesh(shape, color="#9a9a9a", opacity=0.8, **style)
+                shape, style = _shape(pv, grid, part["cell"], gdim, length, outline=False)
+                kwargs = dict(style)
+                if field == "none":
+                    kwargs["color"] = colours[j % len(colours)]
+                else:
+                    kwargs.update(scalars="field", cmap="viridis", clim=clim, show_scalar_bar=False)
+                if part["cell"] not in LINE_CELLS:
+                    kwargs.update(show_edges=edges, edge_color="#303030", line_width=0.5 if edges else None)
+                    kwargs = {k_: v for k_, v in kwargs.items() if v is not None}
+                actor = plotter.add_mesh(shape, smooth_shading=False, **kwargs)
+                if mapper is None and field != "none":
+                    mapper = actor.mapper
+        heading = view[0].label if len(view) == 1 else (title or ", ".join(s.label for s in view))
+        if heading:
+            plotter.add_text(heading, position="upper_left", font_size=12, color="black", font_file=font)
+        if gdim == 2 or camera == "xy":
+            plotter.view_xy()
+            plotter.enable_parallel_projection()
+        elif camera in (None, "iso"):
+            plotter.view_isometric()
+        else:
+            plotter.camera_position = camera
+        plotter.reset_camera()
+    if mapper is not None:  # in the last view, at its right
+        plotter.subplot((len(views) - 1) // ncols, (len(views) - 1) % ncols)
+        scalar_bar = plotter.add_scalar_bar(mapper=mapper, **bar)
+        _use_font(scalar_bar.GetTitleTextProperty(), font)
+        _use_font(scalar_bar.GetLabelTextProperty(), font)
+    if nrows * ncols > 1:
+        plotter.link_views()
+    plotter.set_background("white")
+    folder = os.path.dirname(os.path.abspath(filename))
+    os.makedirs(folder, exist_ok=True)
+    plotter.screenshot(filename)
+    plotter.close()
+    return filename

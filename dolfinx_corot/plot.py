@@ -61,8 +61,9 @@ class Snapshots:
     (a row argument) or of :func:`dolfinx_corot.staging.solve_stages` (stage, row).
 
     at: load factors: the first converged step at or past each (in absolute value) is kept;
-    every: keep every ``every``-th step; neither: keep the last step of each run or stage only
-    (call :meth:`take` to keep others). :meth:`take` keeps the current state under a label.
+    every: keep every ``every``-th step; neither: keep the last step of each stage (of a
+    staged run) or of the run (call :meth:`next_run` between runs to keep each one's), captured
+    at every step. :meth:`take` keeps the current state under a label.
     """
 
     def __init__(self, scene, at: Sequence[float] | None = None, every: int | None = None):
@@ -72,13 +73,21 @@ class Snapshots:
         self.states: list[State] = []
         self._next = 0
         self._step = 0
-        self._pending: tuple | None = None  # (stage name, row) of the last step, if not yet kept
+        self._pending: tuple | None = None  # (stage, run) of the last state kept as "the last step"
+        self._run = 0
 
     def __call__(self, *args) -> None:
         stage, row = (None, args[0]) if len(args) == 1 else args
         self._step += 1
         lam = float(row["load_factor"])
         name = f"{stage.name}: " if stage is not None else ""
+        if self.at is None and self.every is None:  # the last step of each run or stage
+            label = stage.name if stage is not None else f"λ = {lam:.3g}"
+            if self.states and self._pending is not None and self._pending == (id(stage), self._run):
+                self.states.pop()
+            self.states.append(capture(self.scene, label, lam))
+            self._pending = (id(stage), self._run)
+            return
         keep = False
         if self.at is not None:
             while self._next < len(self.at) and abs(lam) >= self.at[self._next] * (1 - 1e-12):
@@ -88,6 +97,12 @@ class Snapshots:
             keep = self._step % self.every == 0
         if keep:
             self.states.append(capture(self.scene, f"{name}λ = {lam:.3g}", lam))
+
+    def next_run(self) -> None:
+        """Start another run (without ``at`` or ``every``: its last step is kept besides the last
+        run's)."""
+        self._run += 1
+        self._next = 0
 
     def take(self, label: str, load_factor: float | None = None) -> State:
         """Keep the current state under ``label`` (collective)."""

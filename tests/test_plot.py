@@ -137,3 +137,19 @@ def test_bad_picture_options_are_refused(tmp_path):
         plot.picture(state, str(tmp_path / "x.png"), layout="stack")
     with pytest.raises(ValueError, match="no state was kept"):
         plot.Snapshots(sc).picture(str(tmp_path / "x.png"))
+
+
+def test_snapshots_keep_the_last_step_of_each_stage(tmp_path):
+    from dolfinx_corot.staging import Stage, solve_stages
+
+    sc, beam = _rollup()
+    extra = sc.load(beam, "tip", force=(0.0, -1.0))
+    shots = plot.Snapshots(sc)
+    solve_stages(sc, [Stage("moment", driver=dc.LoadControl(steps=2)),
+                      Stage("and a force", add=[extra], driver=dc.LoadControl(steps=3))],
+                 approach="I", on_step=shots, quiet=True)
+    assert [s.label for s in shots.states] == ["moment", "and a force"]
+    assert [s.load_factor for s in shots.states] == [1.0, 1.0]
+    if comm.rank == 0:
+        assert not np.allclose(shots.states[0].parts[0]["u"], shots.states[1].parts[0]["u"])
+    shots.picture(str(tmp_path / "stages.png"))

@@ -6,10 +6,13 @@ export OMP_NUM_THREADS ?= 1
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 
-.PHONY: setup demo demos test bench clean-cache
+.PHONY: setup setup-docs demo demos test bench docs docs-check notebooks clean-cache
 
 setup:
 	@bash scripts/setup.sh
+
+setup-docs:
+	@bash scripts/setup.sh docs
 
 demo: setup
 	$(PY) demos/euler_beam_2d.py
@@ -20,6 +23,20 @@ demos: setup
 
 test: setup
 	$(PY) -m pytest -ra tests
+
+# the site: demo pages from demos/*.py and their outputs (shortened runs, reused while fresh)
+docs: setup-docs
+	$(PY) scripts/docs.py
+	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+	@echo "site: docs/_build/html/index.html"
+
+# the built site in headless Chromium: images, internal links, console errors; screenshots
+docs-check: docs
+	$(PY) scripts/docs_check.py docs/_build/html
+
+# every demo as a notebook (output/notebooks/), executed top to bottom in its shortened form
+notebooks: setup-docs
+	$(PY) scripts/notebooks.py
 
 bench: setup
 	$(PY) benchmarks/beam2d.py

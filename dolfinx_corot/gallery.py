@@ -143,6 +143,20 @@ class Demo:
         plot.picture(states, self.path(filename), **options)
         self.pictures.append(filename)
 
+    def work_precision(self, resolution: Sequence, error: Sequence[float], time: Sequence[float], *,
+                       quantity: str, reference: str) -> None:
+        """What accuracy costs: the relative ``error`` of ``quantity`` (against ``reference``) and the
+        wall ``time`` of each run, mesh by mesh (``resolution``: elements, nodes or dofs), to
+        ``<out>/work_precision.json`` on rank 0; the documentation gathers every demo's in one
+        plot (accuracy against time)."""
+        if not (len(resolution) == len(error) == len(time)):
+            raise ValueError("work_precision: resolution, error and time need one entry per run")
+        if self.rank == 0:
+            with open(self.path("work_precision.json"), "w") as f:
+                json.dump({"quantity": quantity, "reference": reference, "resolution": _plain(list(resolution)),
+                           "error": [abs(float(e)) for e in error], "time": [float(t) for t in time]}, f,
+                          indent=1)
+
     def table(self, filename: str, rows: Union[Sequence[dict], np.ndarray],
               columns: Optional[Sequence[str]] = None) -> None:
         """``<out>/<filename>`` as CSV, on rank 0: dict rows (the first row's keys as header), or

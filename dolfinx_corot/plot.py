@@ -14,7 +14,7 @@ top of one another for frames)::
 
 Every part kind is drawn: beams and bars as tubes of their section's radius (lines in a plane
 for 2D scenes), shells and membranes as surfaces, solids by their boundary faces; cells that do
-not exist in a stage are left out. Fields: ``"displacement"`` (|u|), ``"rotation"`` (|θ| of
+not exist in a stage are left out. Fields: ``"displacement"`` (``|u|``), ``"rotation"`` (``|θ|`` of
 the nodal rotations, zero for parts without them), or ``"none"`` (one colour per part). The
 undeformed shape is drawn in grey, the camera looks along z for 2D scenes and isometrically in
 3D, and the colour range is shared by every state of a picture.
@@ -206,7 +206,7 @@ def picture(states, filename: str, *, field: str = "displacement", scale: float 
     PNG ``filename``; returns the path on rank 0, None on the others (collective when given a
     scene, which is captured first).
 
-    field: 'displacement' (|u|), 'rotation' (|θ|) or 'none'; scale: displacement magnification;
+    field: 'displacement' (``|u|``), 'rotation' (``|θ|``) or 'none'; scale: displacement magnification;
     layout: 'overlay' (every state in one view: frames), 'grid' (one view each, ``columns`` per
     row), 'auto' (overlay when every part is made of lines, else grid); undeformed: the initial
     shape in grey (a thin outline of surfaces and solids); camera: 'xy' (2D scenes' default),
@@ -275,6 +275,8 @@ def picture(states, filename: str, *, field: str = "displacement", scale: float 
                 if mapper is None and field != "none":
                     mapper = actor.mapper
         heading = view[0].label if len(view) == 1 else (title or ", ".join(s.label for s in view))
+        if len(view) == 1 and title and k == 0:
+            heading = f"{title}\n{heading}" if heading else title
         if heading:
             plotter.add_text(heading, position="upper_left", font_size=12, color="black", font_file=font)
         if gdim == 2 or camera == "xy":

@@ -8,6 +8,9 @@
 #     that it sees dolfinx; numpy & friends are pinned to Debian's versions by
 #     a constraints file that every pip call in the venv obeys (.venv/pip.conf).
 #  3. The package itself (editable) with numba, pyvista, tqdm, pytest, hypothesis.
+#  4. With the argument "docs": what the documentation site needs besides (Sphinx, MyST, MathJax,
+#     Chromium and its driver with selenium for `make docs-check`; furo, jupytext, nbclient and
+#     ipykernel from PyPI).
 #
 # A stamp file records what was installed; a second run takes about a second.
 set -euo pipefail
@@ -21,6 +24,30 @@ debs=(python3-dolfinx-real python3-gmsh python3-meshio python3-venv python3-h5py
       python3-matplotlib python3-scipy python3-dev libopenblas0-pthread
       python3-pandas libegl1 libegl-mesa0 openmpi-bin)
 pip_pkgs=(numba pyvista tqdm pytest hypothesis)
+docs_debs=(python3-sphinx python3-myst-parser libjs-mathjax chromium chromium-driver python3-selenium)
+docs_pip=("furo==2022.12.7" jupytext nbclient ipykernel)
+
+if [[ "${1:-}" == "docs" ]]; then
+    bash "$0"  # the library first
+    sudo=""; [[ $(id -u) -ne 0 ]] && sudo="sudo"
+    docs_stamp="$venv/.dolfinx_corot-docs"
+    docs_want="$(printf '%s ' "${docs_debs[@]}" "${docs_pip[@]}" | sha256sum | cut -d' ' -f1)"
+    if [[ -f "$docs_stamp" && "$(cat "$docs_stamp")" == "$docs_want" ]]; then
+        exit 0
+    fi
+    missing=()
+    for p in "${docs_debs[@]}"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+    done
+    if (( ${#missing[@]} )); then
+        echo "setup: installing Debian packages for the documentation: ${missing[*]}"
+        $sudo apt-get update -q
+        DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+    fi
+    "$venv/bin/python" -m pip install -q --disable-pip-version-check "${docs_pip[@]}"
+    echo "$docs_want" > "$docs_stamp"
+    exit 0
+fi
 
 # What the stamp must match: this script and the package metadata.
 want="$(cat "$0" pyproject.toml | sha256sum | cut -d' ' -f1)"

@@ -114,7 +114,7 @@ def test_prestressed_string_under_transverse_load():
     assert np.all(res.history.column("mid_ux") == 0.0)
 
 
-def test_failed_step_is_cut_and_the_state_restored_exactly():
+def test_failed_step_is_cut_and_the_state_restored_exactly(hard_case):
     """A load step beyond reach of Newton is halved; the final state equals the fine-step one."""
     tm = polyline([[0.0, 0.0], [0.0, 1.0]], 10, line_name="column")
     Ncr = np.pi**2 * EI / 4
@@ -132,6 +132,14 @@ def test_failed_step_is_cut_and_the_state_restored_exactly():
     fine = dc.solve(scene(), dc.LoadControl(steps=40, final=4.0))
     for c in ("tip_ux", "tip_uy", "tip_rz"):
         assert abs(coarse.history.column(c)[-1] - fine.history.column(c)[-1]) < 1e-9
+    hard_case("One load step to four times the Euler load",
+              "A single step far beyond Newton's reach (at most 6 iterations allowed): the step must be cut "
+              "and retried from the exact last converged state until it converges, and end where 40 small "
+              "steps end.",
+              {"cuts": coarse.totals["cuts"], "steps taken": len(coarse.history),
+               "Newton iterations": coarse.totals["newton_iterations"],
+               "largest difference from 40 steps": max(abs(coarse.history.column(c)[-1] - fine.history.column(c)[-1])
+                                                       for c in ("tip_ux", "tip_uy", "tip_rz"))})
 
     # exact rollback: a failing Newton attempt, then restore, gives the state bit for bit
     sc = scene()

@@ -72,7 +72,7 @@ def test_a_pressed_block_sticks_then_slides_with_mu_times_the_normal_force(quad,
     assert np.all(np.diff(direction) < 0.0) and direction[-1] < 3e-4, direction
 
 
-def test_a_load_reversal_unloads_elastically_then_slides_back_at_mu():
+def test_a_load_reversal_unloads_elastically_then_slides_back_at_mu(hard_case):
     """The push along (2, 1) to +SHIFT (steps 2–7), then back to −SHIFT (steps 8–16), μ = 0.3:
     the block slides forwards at μ times the normal force (1e-6), then, reversed, sticks again:
     in the first step back its shear force changes as the held block's does (within 1.5 %;
@@ -89,7 +89,8 @@ def test_a_load_reversal_unloads_elastically_then_slides_back_at_mu():
     tm = _slider_3d(False)
     push = dc.Amplitude(((0.0, 0.0), (1 / STEPS, 0.0), (7 / STEPS, 1.0), (1.0, -1.0)))
     law = dc.Coulomb(mu=0.3, tangential_factor=20.0)
-    h = dc.solve(_pushed(tm, law, push=push), dc.LoadControl(steps=STEPS)).history
+    result = dc.solve(_pushed(tm, law, push=push), dc.LoadControl(steps=STEPS))
+    h = result.history
     held = dc.solve(_pushed(tm, held=True, push=push), dc.LoadControl(steps=STEPS)).history
     Fx, Fy, Fz = h.column("top_Fx"), h.column("top_Fy"), h.column("top_Fz")
     iterations = h.column("iterations")
@@ -102,6 +103,15 @@ def test_a_load_reversal_unloads_elastically_then_slides_back_at_mu():
         assert F[7] - F[6] == pytest.approx(held.column(col)[7] - held.column(col)[6], rel=0.015)
     assert np.abs(ratio[-6:] / 0.3 - 1.0).max() < 1e-6, ratio  # backwards, along the push's line
     assert np.all(Fx[-6:] * SHIFT[0] < 0.0) and np.abs(Fy[-6:] / Fx[-6:] - 0.5).max() < 3e-3
+    hard_case("A sliding block pushed back: the load reversal in 3D friction",
+              "When the push reverses, every slave passes from slip back to stick: Newton's first correction "
+              "from the last slip state lets the slaves slide along their old slip and the step does not "
+              "converge. The step must be tried again from the elastic predictor, without a cut.",
+              {"Newton iterations per step": iterations.astype(int).tolist(), "cuts": int(h.column("cuts").sum()),
+               "steps tried again from the elastic predictor": [int(k) + 1 for k in restarts],
+               "first step back / held block (Fx)": float((Fx[7] - Fx[6]) / (held.column("top_Fx")[7]
+                                                                               - held.column("top_Fx")[6])),
+               "|F_t|/(μ|F_n|) − 1, last six steps": float(np.abs(ratio[-6:] / 0.3 - 1.0).max())})
 
 
 def test_the_augmented_lagrangian_makes_the_stick_exact():

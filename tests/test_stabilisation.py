@@ -55,7 +55,7 @@ def test_lining_in_a_larger_hole_fails_without_the_stabilisation():
         dc.solve(sc, dc.LoadControl(steps=4, final=2.0, max_cuts=2))
 
 
-def test_lining_in_a_larger_hole_runs_through_with_the_stabilisation():
+def test_lining_in_a_larger_hole_runs_through_with_the_stabilisation(hard_case):
     """With the stabilisation the lining falls 5 mm onto the bottom of the hole, then carries the
     surcharge's squeeze, in 4 steps without cuts. Hand calculations (global equilibrium): the
     soil's base carries the lining's weight and the surcharge, Σ F = W + q·B, so nothing is left
@@ -80,7 +80,13 @@ def test_lining_in_a_larger_hole_runs_through_with_the_stabilisation():
         work["external"] += g1 * (-W_RING / N_RING) * (now[1] - last[1]) + g2 * (-Q) * (now[2] - last[2])
         work["last"] = now
 
-    res = dc.solve(sc, dc.LoadControl(steps=4, final=2.0), on_step=external_work)
+    shots = dc.plot.Snapshots(sc)
+
+    def step(row):
+        external_work(row)
+        shots(row)
+
+    res = dc.solve(sc, dc.LoadControl(steps=4, final=2.0), on_step=step)
     h = res.history
     assert h.column("cuts").sum() == 0
     # global equilibrium: the base carries everything (springs to ground would take their share)
@@ -102,6 +108,16 @@ def test_lining_in_a_larger_hole_runs_through_with_the_stabilisation():
     # the serial numbers on every partition (measured on one rank)
     np.testing.assert_allclose([h.column("invert_uy")[-1], h.column("crown_uy")[-1]], [-0.021557810199, -0.030429353895],
                                rtol=1e-8)
+    hard_case("A lining in a larger hole, held by contact alone",
+              "Before contact closes the lining floats: the tangent is singular at the first solve and no step "
+              "size helps (the run without stabilisation fails). Weak springs to ground, re-anchored after each "
+              "converged solve, must carry it onto the bottom of the hole and then release everything.",
+              {"steps": len(h), "Newton iterations": res.totals["newton_iterations"], "cuts": res.totals["cuts"],
+               "peak spring force (first step)": float(h.column("stab_peak")[0]),
+               "spring force left at the end": float(h.column("stab_force").max()),
+               "spring work / external work": float(h.column("stab_work")[-1] / work["external"]),
+               "base reaction − (W + qB), relative": float(h.column("base_Fy")[-1] / (W_RING + Q * WIDTH) - 1.0)},
+              picture=(shots.states, {"title": "lining settled in the hole, then squeezed (×1)"}))
 
 
 # -- a block pressed onto a support through contact ------------------------------------------------

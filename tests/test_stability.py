@@ -35,7 +35,7 @@ def _column(gdim: int, n: int = 10):
     return sc
 
 
-def test_load_control_stops_at_the_bifurcation_of_a_column():
+def test_load_control_stops_at_the_bifurcation_of_a_column(hard_case):
     """Load control on a perfect column past its Euler load: the tangent gains a negative
     eigenvalue between λ = 0.91 and 1.04; the run stops at the last state before it with the
     critical load, interpolated from the smallest eigenvalue, within 0.5 % of π²EI/(4L²)
@@ -50,6 +50,14 @@ def test_load_control_stops_at_the_bifurcation_of_a_column():
     assert (cp.negative_before, cp.negative_after) == (0, 1)
     assert cp.load_factor == pytest.approx(1.0, rel=5e-3)
     assert cp.load_factor == pytest.approx(1.0, abs=1e-4)
+    hard_case("A perfect column loaded past its Euler load under load control",
+              "A straight path whose tangent turns indefinite at a bifurcation: load control would go on "
+              "along the unstable straight path without a warning. The run must stop at the last stable "
+              "state and estimate the critical load from the smallest eigenvalue (10 beams, 2D).",
+              {"critical load / π²EI/(4L²)": cp.load_factor, "bracket of load factors": list(cp.bracket),
+               "negative eigenvalues before → after": f"{cp.negative_before} → {cp.negative_after}",
+               "steps kept": len(result.history), "Newton iterations": result.totals["newton_iterations"],
+               "cuts": result.totals["cuts"]})
 
 
 @pytest.mark.parametrize("gdim, critical", [(2, 1.0), (3, 1.5)])
@@ -88,7 +96,7 @@ def _truss():
     return sc
 
 
-def test_load_control_past_a_limit_point_stops_instead_of_jumping():
+def test_load_control_past_a_limit_point_stops_instead_of_jumping(hard_case):
     """Past the truss's limit load, load control used to leap to the inverted branch (apex
     −0.04 → −0.216) and report completion. Now the step that leaps is recognised — its Newton
     iterates cross states with a negative eigenvalue — and the run stops before it; the bracket
@@ -110,17 +118,34 @@ def test_load_control_past_a_limit_point_stops_instead_of_jumping():
                                                                                  rel=1e-6)
     result = dc.solve(_truss(), dc.LoadControl(steps=10, final=2.0, at_critical_point="continue"))
     assert result.completed and [c.kind for c in result.critical_points] == ["limit point (jumped)"]
+    hard_case("Load control past the limit load of a shallow truss",
+              "Beyond its limit load the von Mises truss has no nearby equilibrium: Newton leaps to the "
+              "inverted branch and, unchecked, reports a converged step. The leap must be recognised (its "
+              "iterates cross unstable states) and the run stopped before it, with the limit load bracketed.",
+              {"limit load estimate / exact": cp.load_factor / exact, "bracket of load factors": list(cp.bracket),
+               "exact limit load factor": exact, "last apex deflection kept": err.value.result.history.rows[-1][
+                   "apex_uy"], "Newton iterations": err.value.result.totals["newton_iterations"],
+               "cuts": err.value.result.totals["cuts"]})
 
 
-def test_arc_length_lists_the_limit_point():
+def test_arc_length_lists_the_limit_point(hard_case):
     """Arc-length follows the truss through its limit point: the count of negative eigenvalues
     changes where λ turns, and the limit point's load (a parabola through the path points around
     it) is within 2 % of the exact one for this coarse path."""
     exact = _truss_limit()
-    result = dc.solve(_truss(), dc.ArcLength(initial_increment=0.05, max_steps=8))
+    sc = _truss()
+    shots = dc.plot.Snapshots(sc, every=2)
+    result = dc.solve(sc, dc.ArcLength(initial_increment=0.05, max_steps=8), on_step=shots)
     first = result.critical_points[0]
     assert first.kind == "limit point" and (first.negative_before, first.negative_after) == (0, 1)
     assert first.load_factor == pytest.approx(exact, rel=2e-2)
+    hard_case("Arc-length through the limit point of a shallow truss",
+              "The load must fall after the limit point: arc-length follows the path through it and snaps "
+              "the truss through, counting negative eigenvalues at every state to list the limit point.",
+              {"limit load estimate / exact": first.load_factor / exact, "steps": len(result.history),
+               "Newton iterations": result.totals["newton_iterations"], "cuts": result.totals["cuts"],
+               "apex deflection at the end": result.history.rows[-1]["apex_uy"]},
+              picture=(shots.states, {"field": "displacement", "title": "von Mises truss, arc-length states"}))
 
 
 def test_limit_load_says_when_the_path_has_no_maximum():

@@ -419,7 +419,7 @@ class ArcLength:
     Δl·√(desired/used iterations), within [min_length, max_length].
 
     initial_increment: load-factor increment of the first step (sets Δl);
-    max_steps; max_load_factor: stop when |λ| reaches it; stop: a function of
+    max_steps; max_load_factor: stop when ``|λ|`` reaches it; stop: a function of
     the history row that returns True to stop (e.g. a displacement reached);
     psi: load term weight (0: cylindrical); max_growth: largest factor by which Δl
     grows from one step to the next; stability: count the negative eigenvalues of the tangent

@@ -18,3 +18,33 @@ def cantilever_elastica_force_ratio(w_over_L: float) -> float:
         raise ValueError(f"w/L = {w_over_L} is outside (0, 0.806), the first branch of the elastica")
     k = brentq(lambda k: 2.0 * k / ellipk(k * k) - w_over_L, 1e-12, 0.8375)  # 2k/K(k) is largest (0.806) there
     return float((2.0 * ellipk(k * k) / np.pi) ** 2)
+
+
+def cantilever_uniform_load(k: float, points: int = 2001) -> dict:
+    """The inextensible Bernoulli cantilever (clamped at s = 0, length L) under a uniform dead load
+    q per unit length in −y, transverse to its straight axis along x, at k = qL³/EI: the elastica
+    EI θ'' = q (L − s) cos θ, θ(0) = 0, θ'(L) = 0 (EI θ' is the moment at s of the load beyond
+    it), x' = cos θ, y' = sin θ, solved as a boundary-value problem by collocation
+    (scipy.integrate.solve_bvp, tolerance 1e-10).
+
+    Returns, in units of L, {"x_tip", "y_tip" (negative: along the load), "theta_tip" (the tip
+    rotation, negative), "s", "x", "y", "moment" (EI θ'/(qL²) along s)}."""
+    from scipy.integrate import solve_bvp
+
+    s = np.linspace(0.0, 1.0, points)
+
+    def rhs(t, z):  # z = (θ, θ', x, y), lengths in L, θ toward the load
+        return np.vstack([z[1], k * (1.0 - t) * np.cos(z[0]), np.cos(z[0]), np.sin(z[0])])
+
+    def bc(a, b):
+        return np.array([a[0], b[1], a[2], a[3]])
+
+    guess = np.zeros((4, points))
+    guess[0] = -k * (s - s**2 + s**3 / 3) / 2  # the small-deflection slope
+    guess[2] = s
+    sol = solve_bvp(rhs, bc, s, guess, tol=1e-10, max_nodes=200000)
+    if not sol.success:
+        raise RuntimeError(f"cantilever_uniform_load(k = {k}): the collocation did not converge ({sol.message})")
+    theta, dtheta, x, y = sol.sol(s)
+    return {"x_tip": float(x[-1]), "y_tip": float(y[-1]), "theta_tip": float(theta[-1]), "s": s, "x": x, "y": y,
+            "moment": dtheta / k}

@@ -29,6 +29,7 @@ from .contact.laws import ContactError, Penalty
 from .contact.mortar import MortarInterface3D
 from .contact.pair import ContactPair
 from .io.mesh import TaggedMesh
+from .loads import FollowerLoads
 from .materials import Elastic
 from .parts import Coupled, Part, PartRef, part_for_mesh
 from .parts.base import finite_vector
@@ -252,7 +253,8 @@ class Scene:
         self._prescribed += 1
         return condition
 
-    def load(self, part: PartRef, where: str, force=None, moment=None, amplitude=None, traction=None) -> Condition:
+    def load(self, part: PartRef, where: str | None, force=None, moment=None, amplitude=None, traction=None,
+             per_length=None, axes: str = "global", follower: bool = False) -> Condition:
         """Dead point force and moment at each node of ``where``, scaled by the load factor λ
         or, with an ``amplitude`` (:class:`dolfinx_corot.Amplitude`), by amplitude(λ).
 
@@ -260,11 +262,38 @@ class Scene:
         moment (mx, my, mz), a fixed spatial vector. Solids: ``traction`` (per unit
         reference area, a facet group) or ``force`` at each node of the group.
 
+        Beams and bars: ``per_length``, a uniform load per unit length on the elements of ``part``
+        (those in group ``where``; None: all), as work-equivalent nodal forces and, for beams, the
+        fixed-end moments ±q l²/12 (:mod:`dolfinx_corot.elements.uniform_load`):
+
+        * ``axes='global'`` (default): gdim components in global axes, per unit reference length,
+          dead (a weight, a wind load of fixed direction);
+        * ``axes='element'``: components in each element's axes (2D: along the element, then
+          normal to it, e_z × t; 3D: the beam's local x, y, z), dead: fixed at the element's
+          reference axes;
+        * ``follower=True`` (2D, ``axes='element'``): the load turns with the element and acts per
+          unit current length (a pressure on a ring or an arch: ``per_length=(0.0, -p)`` with the
+          normal e_z × t pointing away from the loaded side); its load stiffness enters the tangent
+          (:mod:`dolfinx_corot.loads`).
+
         Returns the load as a :class:`~dolfinx_corot.conditions.Condition` (construction stages
         may add it — applied over that stage — or remove it — taken off over that stage).
         """
         model = part.model
         condition = Condition("load", _on(part, where))
+        if axes not in ("global", "element"):
+            raise ValueError(f"load on '{where}': axes = {axes!r} is not 'global' or 'element'")
+        if per_length is not None:
+            if force is not None or moment is not None or traction is not None:
+                raise ValueError(f"load on '{where}': give per_length alone (a distributed load), or point loads")
+            n = model.gdim if (axes == "global" or model.gdim == 3) else 2
+            q = finite_vector(f"load per length on '{where}'", "per_length", per_length, n)
+            model.add_line_load(part, where, q, axes, bool(follower), amplitude, condition)
+            self._loads += 1
+            return condition
+        if follower:
+            raise ValueError(f"load on '{where}': follower=True is for distributed loads (per_length on beams, "
+                             "scene.pressure on surfaces); point loads here are dead")
         if traction is not None:
             model.add_traction(where, finite_vector(f"load '{where}'", "traction", traction, model.gdim), amplitude,
                                condition)
@@ -273,6 +302,29 @@ class Scene:
         if values is not None:
             model.add_load(where, values, amplitude, condition)
             self._loads += 1
+        return condition
+
+    def pressure(self, part: PartRef, where: str | None = None, p: float = 0.0, *, follower: bool = True,
+                 amplitude=None) -> Condition:
+        """A uniform pressure p, scaled by the load factor λ (or by ``amplitude(λ)``).
+
+        * Shells and membranes (``where``: a cell group of the part, None: all its cells): p per
+          unit area along each cell's normal n, by the right-hand rule over its nodes (a closed
+          surface whose cells are numbered anticlockwise seen from outside is inflated by p > 0).
+        * Solids (``where``: a facet group): p per unit area pressing on the faces, along their
+          inward normal (p > 0 pushes into the solid).
+
+        follower=True (default): the pressure acts per unit current area along the current normal
+        (a fluid's pressure) and its load stiffness enters the tangent (:mod:`dolfinx_corot.loads`;
+        solids: p J F⁻ᵀN in the residual form); False: a dead load p n₀ per unit reference area,
+        fixed at the reference normals. Follower loads are followed by load and displacement
+        control; arc-length and staged runs refuse them.
+        """
+        if not (isinstance(p, (int, float)) and np.isfinite(p)):
+            raise ValueError(f"pressure on '{where}': p = {p!r} must be a finite number")
+        condition = Condition("load", _on(part, where) if where else f"pressure on {part.kind} '{part.name}'")
+        part.model.add_pressure(part, where, float(p), bool(follower), amplitude, condition)
+        self._loads += 1
         return condition
 
     def gravity(self, part: PartRef, acceleration, density: float | None = None, where: str | None = None,
@@ -488,13 +540,21 @@ class Scene:
         out = [Contact(self.interfaces)] if self.interfaces else []
         if self.stabilisers:
             out.append(Stabilisation(self.stabilisers))
+        followers = [f for m in self._models.values() for f in m.followers]
+        if followers:
+            out.append(FollowerLoads(followers))
         return out
+
+    @property
+    def follower_loads(self) -> bool:
+        """Whether the scene has loads that follow the configuration (pressures, follower line loads)."""
+        return any(m.followers or m.has_follower_loads for m in self._models.values())
 
     def effects(self) -> list[str]:
         """What will be assembled, in words."""
         out = [m.effect() for m in self._models.values()]
         if self._loads:
-            out.append("dead loads")
+            out.append("dead loads" if not self.follower_loads else "loads, some following the configuration")
         if self._prescribed:
             out.append("prescribed displacements")
         for itf in self.interfaces:

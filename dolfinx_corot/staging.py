@@ -148,6 +148,10 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
     if approach not in APPROACHES:
         raise ValueError(f"solve_stages: approach = {approach!r} is not one of {APPROACHES}")
     models = scene.model.models if scene.model.coupled else [scene.model]
+    if scene.follower_loads:
+        raise NotImplementedError("solve_stages: follower loads (pressures, follower loads per length) cannot be "
+                                  "staged yet (each stage ramps constant load vectors); give them as dead loads "
+                                  "(follower=False) or solve without stages")
     if scene.model.amplitudes:
         raise ValueError("solve_stages: loads with an amplitude cannot be staged (each stage ramps its loads from "
                          "where it starts to its own); add or remove the loads in the stages instead")

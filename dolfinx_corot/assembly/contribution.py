@@ -42,6 +42,9 @@ class Contribution:
 
     couplings_changed = False
     symmetric_tangent = True  # whether its tangent blocks are symmetric (else the system solves by LU)
+    # a load that follows the configuration (a pressure): add_residual adds external forces (counted
+    # with the loads in the residual's scale), add_tangent still adds the derivative of −f
+    follows_configuration = False
 
     def couplings(self) -> np.ndarray:
         """(k, n) global dofs, each row a dense block coupled by this contribution (−1: none)."""

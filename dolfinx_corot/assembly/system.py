@@ -53,6 +53,8 @@ class Model(Protocol):
     def forms(self) -> tuple[object, object]: ...            # (vector form, matrix form)
     def dirichlet_bcs(self) -> list: ...                        # supports and prescribed motion
     def set_load_factor(self, load_factor: float) -> None: ...  # prescribed values at λ
+    def set_follower_factor(self, load_factor: float) -> None: ...  # follower loads' factor at λ
+    def follower_form(self): ...                               # follower loads (a linear form) or None
     def external_force(self, b: PETSc.Vec, amplitude=None) -> None: ...  # unit loads of one amplitude
     def displacement_vector(self) -> PETSc.Vec: ...             # x in the layout of V (constraints)
     def update(self, dx: PETSc.Vec) -> None: ...                # x ← x ⊕ dx
@@ -109,6 +111,13 @@ class System:
                                       "(linear_solver='direct' or 'auto')")
         for c in self.contributions:
             c.bind(self)
+        # contributions that are loads following the configuration add to the external forces
+        self._load_contributions = [c for c in self.contributions if c.follows_configuration]
+        self._force_contributions = [c for c in self.contributions if not c.follows_configuration]
+        # the parts' own follower loads (a solid's pressure): linear forms at the current configuration
+        self._follower_forms = [m.follower_form() for m in self.models]
+        has_forms = any(f is not None for f in self._follower_forms)
+        self.fload = petsc.duplicate(self.b) if (self._load_contributions or has_forms) else None
         self._version = 0          # counts changes of the configuration
         self._tangent_version = -1  # the configuration of a tangent assembled ahead (tangent_at)
         self.C: PETSc.Mat | None = None   # the contributions' matrix over their declared couplings
@@ -152,24 +161,37 @@ class System:
         dolfinx.fem.petsc.assemble_vector(self.fint, self.L)
         self.fint.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
 
+    def _assemble_follower_forms(self) -> None:
+        """fload = the parts' follower loads at the current configuration and load factor."""
+        with self.fload.localForm() as f:
+            f.set(0.0)
+        if self._follower_forms[0] is not None:
+            dolfinx.fem.petsc.assemble_vector(self.fload, self._follower_forms[0])
+        self.fload.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+
     def _assemble_fint(self) -> None:
         self._assemble_parts()
+        if self.fload is not None:
+            self._assemble_follower_forms()
         if self.contributions:
             t = time.perf_counter()
-            self._add_blocks(self.fint, lambda c, add: c.add_residual(add))
+            self._add_blocks(self.fint, lambda c, add: c.add_residual(add), self._force_contributions)
+            if self._load_contributions:
+                self._add_blocks(self.fload, lambda c, add: c.add_residual(add), self._load_contributions)
             # something is near: the contributions' matrix and Newton's safeguards are needed
             self.engaged = bool(self.comm.allreduce(any(c.engaged() for c in self.contributions), op=MPI.LOR))
             self.timings.contributions += time.perf_counter() - t
 
-    def _add_blocks(self, vec: PETSc.Vec, call) -> None:
-        """vec += the blocks each contribution adds through ``call(contribution, add)`` (global dofs)."""
+    def _add_blocks(self, vec: PETSc.Vec, call, contributions=None) -> None:
+        """vec += the blocks each contribution (of ``contributions``; default: all) adds through
+        ``call(contribution, add)`` (global dofs)."""
         def add(dofs, values):
             d = np.asarray(dofs).ravel().astype(PETSc.IntType)
             v = np.asarray(values, dtype=float).ravel()
             free = d >= 0  # (a vector, unlike a matrix, does not skip negative indices)
             vec.setValues(d[free], v[free], addv=PETSc.InsertMode.ADD_VALUES)
 
-        for c in self.contributions:
+        for c in (self.contributions if contributions is None else contributions):
             call(c, add)
         vec.assemblyBegin()
         vec.assemblyEnd()
@@ -237,11 +259,15 @@ class System:
         """
         t = time.perf_counter()
         self.load_factor = load_factor
+        for m in self.models:
+            m.set_follower_factor(load_factor)
         self._assemble_fint()
         self.fext.copy(self.fext_total)
         self.fext_total.scale(load_factor)
         for amp, v in self.amplitude_loads:
             self.fext_total.axpy(amp(load_factor), v)
+        if self.fload is not None:  # follower loads at this configuration and load factor
+            self.fext_total.axpy(1.0, self.fload)
         self.fext_total.copy(self.b)
         self.b.axpy(-1.0, self.fint)
         self._constrain_residual(load_factor)
@@ -680,7 +706,7 @@ class System:
         for c in self.contributions:
             c.destroy()
         self.linear.destroy()
-        petsc.destroy(self.C, self.A, self.b, self.fint, self.dx, self.step_dx, self.lift, self.fext,
+        petsc.destroy(self.fload, self.C, self.A, self.b, self.fint, self.dx, self.step_dx, self.lift, self.fext,
                       self.fext_total, self._rhs, *(v for _, v in self.amplitude_loads))
 
 
@@ -825,6 +851,17 @@ class CoupledSystem(System):
             with v.localForm() as f:
                 arrays.append(f.array.copy())
         self._add_from_models(self.fint, arrays)
+
+    def _assemble_follower_forms(self) -> None:
+        arrays = []
+        for form, v in zip(self._follower_forms, self._mvec):
+            with v.localForm() as f:
+                f.set(0.0)
+            if form is not None:
+                dolfinx.fem.petsc.assemble_vector(v, form)
+            with v.localForm() as f:
+                arrays.append(f.array.copy())
+        self._add_from_models(self.fload, arrays)
 
     def _displacements(self) -> np.ndarray:
         """Owned entries of the displacement vector (rotational entries 0). An owned dof may be held

@@ -39,7 +39,8 @@ import numpy as np
 def line_loads(X: np.ndarray, q: np.ndarray, bending: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Nodal forces and moments of a uniform load on straight two-node elements.
 
-    X: (n, 2, g) reference node coordinates, g = 2 or 3; q: (g,) load per unit length;
+    X: (n, 2, g) reference node coordinates, g = 2 or 3; q: (g,) load per unit length, or (n, g)
+    one per element;
     bending: (n,) True for beams (moments added), False for bars.
     Returns forces (n, 2, g) and moments (n, 2) in 2D (about z) or (n, 2, 3) in 3D.
     """
@@ -47,7 +48,7 @@ def line_loads(X: np.ndarray, q: np.ndarray, bending: np.ndarray) -> tuple[np.nd
     length = np.linalg.norm(d, axis=1)
     forces = np.repeat((0.5 * length[:, None] * q)[:, None, :], 2, axis=1)
     if X.shape[2] == 2:
-        m = (d[:, 0] * q[1] - d[:, 1] * q[0]) * length / 12.0 * bending
+        m = (d[:, 0] * q[..., 1] - d[:, 1] * q[..., 0]) * length / 12.0 * bending
         moments = np.stack([m, -m], axis=1)
     else:
         m = np.cross(d, q) * (length / 12.0 * bending)[:, None]
@@ -56,7 +57,8 @@ def line_loads(X: np.ndarray, q: np.ndarray, bending: np.ndarray) -> tuple[np.nd
 
 
 def triangle_loads(X: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Nodal forces (n, 3, 3) of a uniform load q (3,) per unit area on triangles X (n, 3, 3)."""
+    """Nodal forces (n, 3, 3) of a uniform load q (3,) (or (n, 3), one per triangle) per unit area on
+    triangles X (n, 3, 3)."""
     area = 0.5 * np.linalg.norm(np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]), axis=1)
     return np.repeat((area[:, None] * q / 3.0)[:, None, :], 3, axis=1)
 
@@ -66,7 +68,7 @@ _GAUSS = 0.5 + np.array([-0.5, 0.5]) / np.sqrt(3.0)
 
 
 def quad_loads(X: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Nodal forces (n, 4, 3) of a uniform load q (3,) per unit area on bilinear quadrilaterals
+    """Nodal forces (n, 4, 3) of a uniform load q (3,) (or (n, 3)) per unit area on bilinear quadrilaterals
     X (n, 4, 3) whose nodes are in DOLFINx's order (0, 0), (1, 0), (0, 1), (1, 1) of the unit
     square: ∫ N_a dA by 2×2 Gauss points."""
     weights = np.zeros((len(X), 4))
@@ -77,4 +79,4 @@ def quad_loads(X: np.ndarray, q: np.ndarray) -> np.ndarray:
             deta = np.array([-(1 - xi), -xi, 1 - xi, xi])
             jac = np.linalg.norm(np.cross(np.einsum("a,nai->ni", dxi, X), np.einsum("a,nai->ni", deta, X)), axis=1)
             weights += 0.25 * jac[:, None] * N
-    return weights[:, :, None] * q
+    return weights[:, :, None] * (q[:, None, :] if np.ndim(q) == 2 else q)

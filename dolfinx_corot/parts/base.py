@@ -113,6 +113,8 @@ class Part:
     _rotation_out = None
     symmetric_tangent = True
     kind_name = "part"
+    followers: tuple = ()      # follower loads assembled as a contribution (structures)
+    has_follower_loads = False  # follower loads in the part's own forms (solids)
 
     def _init_conditions(self) -> None:
         self.ndof = len(self.dof_names)
@@ -645,6 +647,20 @@ class Part:
     def add_membrane(self, where, E, nu, thickness) -> PartRef:
         self._refuse_kind("membrane", where, "membranes need a triangle or quadrilateral mesh in 3D "
                           "(from_gmsh(model, gdim=3))")
+
+    def add_line_load(self, part: PartRef, where, q, axes, follower, amplitude=None, condition=None) -> Condition:
+        self._refuse_kind("load per length on", where, "it acts on beams and bars")
+
+    def add_pressure(self, part: PartRef, where, p, follower, amplitude=None, condition=None) -> Condition:
+        self._refuse_kind("pressure on", where, "it acts on shells, membranes and the faces of solids")
+
+    def set_follower_factor(self, load_factor: float) -> None:
+        """The load factor of the residual about to be assembled (follower loads in the part's forms)."""
+
+    def follower_form(self):
+        """The linear form of the part's own follower loads at the current configuration (external
+        forces, assembled with the loads), or None."""
+        return None
 
     def add_traction(self, where: str, traction: np.ndarray, amplitude=None, condition=None) -> Condition:
         raise ValueError(f"load '{where}': tractions act on solids; structures take forces and moments")

@@ -25,8 +25,10 @@ from .. import _dolfinx, rotations
 from ..conditions import Condition
 from ..elements import beam3d as law3d
 from ..elements import line2d as law2d
+from ..elements import follower as follower_kernels
 from ..elements import uniform_load
 from ..io.mesh import TaggedMesh
+from ..loads import FollowerLoad
 from ..kernels import beam3d as kernels3d
 from ..kernels import line2d as kernels2d
 from .base import AdditiveState, Part, PartRef
@@ -65,6 +67,7 @@ class LineFrame(Part):
         self._bending = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
         self._element_props: list[tuple[str, list[float]]] = []
         self._gravity: list[tuple[str, str | None, np.ndarray, object, Condition]] = []
+        self.followers: list[FollowerLoad] = []
         self._init_conditions()
 
     # -- building -----------------------------------------------------------
@@ -171,8 +174,58 @@ class LineFrame(Part):
         self._gravity.append((label, where, q, amplitude, condition))
         return condition
 
+    def _loaded_cells(self, part: PartRef, where: str | None, what: str) -> np.ndarray:
+        """Owned cells of ``part`` (within group ``where``), refused if there are none."""
+        label = self._label(part)
+        cells = self._weight_cells(label, where)
+        if not self.comm.allreduce(len(cells)):
+            raise ValueError(f"{what} on {label}: group '{where}' holds none of its elements")
+        return cells
+
+    def add_line_load(self, part: PartRef, where: str | None, q: np.ndarray, axes: str, follower: bool,
+                      amplitude=None, condition: Condition | None = None) -> Condition:
+        """A uniform load per unit length on the beams or bars of ``part`` (see ``Scene.load``)."""
+        label = self._label(part)
+        if self.tdim != 1:
+            raise ValueError(f"load per length on {label}: it acts on beams and bars; on shells and membranes "
+                             "give a pressure (scene.pressure) or a weight (scene.gravity)")
+        cells = self._loaded_cells(part, where, "load per length")
+        condition = condition or Condition("load", f"per length on {label}")
+        if follower:
+            if self.gdim != 2:
+                raise NotImplementedError(f"follower load per length on {label}: 2D beams and bars only; in 3D "
+                                          "give a dead load (follower=False) in global or element axes")
+            if axes != "element":
+                raise ValueError(f"follower load per length on {label}: a follower load turns with the elements, "
+                                 "so give it in element axes (axes='element': along the element, normal to it)")
+            self.followers.append(FollowerLoad(self, label, "line2d", cells, q, self._bending[cells], amplitude,
+                                               condition))
+            return condition
+        if axes == "global":
+            self._gravity.append((label, where, q, amplitude, condition))
+            return condition
+
+        def in_element_axes(cells, X, q=q):
+            axes = self._initial_axes(cells, X)
+            return np.einsum("i,nij->nj", q, axes[:, : len(q)])
+        self._gravity.append((label, where, in_element_axes, amplitude, condition))
+        return condition
+
+    def _initial_axes(self, cells: np.ndarray, X: np.ndarray) -> np.ndarray:
+        """(n, gdim, gdim) the rows of each element's axes in its reference configuration: along the
+        element, then normal to it (2D: e_z × t)."""
+        t = X[:, 1] - X[:, 0]
+        t /= np.linalg.norm(t, axis=1)[:, None]
+        return np.stack([t, t @ follower_kernels.R90.T], axis=1)
+
+    def add_pressure(self, part: PartRef, where: str | None, p: float, follower: bool, amplitude=None,
+                     condition: Condition | None = None) -> Condition:
+        raise ValueError(f"pressure on {self._label(part)}: a pressure acts on surfaces (shells, membranes, the "
+                         "faces of solids); on beams and bars give a load per length (scene.load(..., per_length=))")
+
     def load_conditions(self) -> list:
-        return [(amp, cond) for *_, amp, cond in self._point_loads + self._gravity]
+        return [(amp, cond) for *_, amp, cond in self._point_loads + self._gravity] + \
+            [(f.amplitude, f.condition) for f in self.followers]
 
     def _add_distributed_loads(self, b: PETSc.Vec, amplitude) -> None:
         """Add the self-weight loads of one amplitude (None: proportional to λ) at unit factor,
@@ -188,6 +241,8 @@ class LineFrame(Part):
             cells = self._weight_cells(label, where)
             blocks = cell_blocks[cells]
             X = self.reference[blocks] + self._activation_translations(cells)
+            if callable(q):  # one load per element, from its reference geometry
+                q = q(cells, X)
             if self.tdim == 1:
                 forces, moments = uniform_load.line_loads(X, q, self._bending[cells])
                 np.add.at(arr[:, g:], blocks, moments.reshape(len(cells), 2, self.ndof - g))
@@ -531,6 +586,16 @@ class Frame3D(Rotations3D, LineFrame):
     def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray:
         """The section's contact radius (a pipe's or a circle's outer radius, a rectangle's half depth)."""
         return self._contact_radius[cells]
+
+    def _initial_axes(self, cells: np.ndarray, X: np.ndarray) -> np.ndarray:
+        """(n, 3, 3) each element's reference axes: x along it, y the orientation vector's part
+        normal to x, z = x × y (the beam's local axes)."""
+        x = X[:, 1] - X[:, 0]
+        x /= np.linalg.norm(x, axis=1)[:, None]
+        v = self.cell_properties(cells)[:, -3:]
+        y = v - np.einsum("ni,ni->n", v, x)[:, None] * x
+        y /= np.linalg.norm(y, axis=1)[:, None]
+        return np.stack([x, y, np.cross(x, y)], axis=1)
 
     def _check_geometry(self, cells, label, props):
         super()._check_geometry(cells, label, props)

@@ -16,9 +16,11 @@ import dolfinx.fem
 
 from ..elements import membrane_quad as quad_law
 from ..elements import shell_triangle as shell_law
+from ..conditions import Condition
 from ..io.mesh import TaggedMesh
 from ..kernels import membrane_quad as kernels_mq
 from ..kernels import shell3d as kernels_shell
+from ..loads import FollowerLoad
 from .base import PartRef
 from .cells import mesh_extent, quadrilateral_problems, refuse, triangle_problems
 from .frame import Frame3D, LineFrame, Rotations3D
@@ -74,6 +76,27 @@ class Surface3D(Rotations3D, LineFrame):
         return gather_surface(self, where, blocks[:, order], self.V.tabulate_dof_coordinates(), offsets=0.5 * t,
                               two_sided=True, modulus=modulus, cells=cells)
 
+
+    def add_pressure(self, part: PartRef, where: str | None, p: float, follower: bool, amplitude=None,
+                     condition: Condition | None = None) -> Condition:
+        """A uniform pressure p on the shells or membranes of ``part`` (within cell group ``where``), along
+        each cell's normal by the right-hand rule over its nodes (see ``Scene.pressure``)."""
+        label = self._label(part)
+        cells = self._loaded_cells(part, where, "pressure")
+        condition = condition or Condition("load", f"pressure on {label}")
+        kind = "triangle" if self.nodes_per_cell == 3 else "quad"
+        if follower:
+            self.followers.append(FollowerLoad(self, label, kind, cells, p, None, amplitude, condition))
+            return condition
+
+        def along_initial_normals(cells, X, p=p):
+            if kind == "triangle":
+                n = np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
+            else:  # the normal at the centre of the bilinear patch (nodes (0,0), (1,0), (0,1), (1,1))
+                n = np.cross(X[:, 1] + X[:, 3] - X[:, 0] - X[:, 2], X[:, 2] + X[:, 3] - X[:, 0] - X[:, 1])
+            return p * n / np.linalg.norm(n, axis=1)[:, None]
+        self._gravity.append((label, where, along_initial_normals, amplitude, condition))
+        return condition
 
     def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray:
         """The thickness."""

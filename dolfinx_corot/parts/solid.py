@@ -97,6 +97,10 @@ class Solid(AdditiveState, Part):
         self.law: type | None = None
         self._regions: list[tuple[str, str, float, float]] = []
         self._tractions: list[tuple[str, np.ndarray, object, Condition]] = []
+        # pressures: (where, p, amplitude, condition); follower ones with their factor g(λ) (a Constant)
+        self._dead_pressures: list[tuple[str, float, object, Condition]] = []
+        self._follower_pressures: list[tuple[str, float, object, Condition, object]] = []
+        self._follower_form = None
         # (where, b, × material ρ, amplitude, condition)
         self._body: list[tuple[str | None, np.ndarray, bool, object, Condition]] = []
         self._init_conditions()
@@ -166,6 +170,51 @@ class Solid(AdditiveState, Part):
         self._tractions.append((where, np.asarray(traction, dtype=float), amplitude, condition))
         return condition
 
+    def add_pressure(self, part, where: str | None, p: float, follower: bool, amplitude=None,
+                     condition: Condition | None = None) -> Condition:
+        """A uniform pressure p on the facets of group ``where``, along their inward normal: dead (p N₀ per
+        unit reference area) or following (p n per unit current area: p J F⁻ᵀN, Nanson's formula), see
+        ``Scene.pressure``."""
+        if where is None or self.tmesh.facets(where) is None:
+            raise ValueError(f"pressure on '{where}': a group of facets (dimension {self.tdim - 1}) read with "
+                             "from_gmsh is needed")
+        condition = condition or Condition("load", f"pressure on '{where}'")
+        if not follower:
+            self._dead_pressures.append((where, p, amplitude, condition))
+            return condition
+        factor = dolfinx.fem.Constant(self.V.mesh, PETSc.ScalarType(0.0))
+        self._follower_pressures.append((where, p, amplitude, condition, factor))
+        self.has_follower_loads = True
+        self.symmetric_tangent = False  # the load stiffness of a pressure on an open surface
+        self._forms = None
+        self._follower_form = None
+        return condition
+
+    def set_follower_factor(self, load_factor: float) -> None:
+        for _, _, amplitude, condition, factor in self._follower_pressures:
+            g = load_factor if amplitude is None else float(amplitude(load_factor))
+            factor.value = g if condition.exists else 0.0
+
+    def _follower_load(self, u, v):
+        """The follower pressures' load as a UFL form (external force: −g p J F⁻ᵀN · v on each group)."""
+        if not self._follower_pressures:
+            return None
+        ds = ufl.Measure("ds", domain=self.V.mesh, subdomain_data=self.tmesh.facet_tags)
+        N = ufl.FacetNormal(self.V.mesh)
+        if self.large_rotations:
+            F = ufl.Identity(self.gdim) + self._gradient(u)
+            normal = ufl.det(F) * ufl.dot(ufl.inv(F).T, N)
+        else:
+            normal = N
+        terms = [-factor * p * ufl.inner(normal, v) * ds(self.tmesh.groups[where][1])
+                 for where, p, _, _, factor in self._follower_pressures]
+        return sum(terms[1:], terms[0])
+
+    def follower_form(self):
+        if self._follower_pressures and self._follower_form is None:
+            self._follower_form = dolfinx.fem.form(self._follower_load(self.state, ufl.TestFunction(self.V)))
+        return self._follower_form
+
     def add_body_force(self, where: str | None, force: np.ndarray, amplitude=None,
                        material_density: bool = False, condition: Condition | None = None) -> Condition:
         """Body force per unit reference volume on the cells of ``where`` (all if None): ``force``,
@@ -201,7 +250,8 @@ class Solid(AdditiveState, Part):
                              "or pass density= to scene.gravity")
 
     def load_conditions(self) -> list:
-        return [(amp, cond) for *_, amp, cond in self._tractions + self._body + self._point_loads]
+        return [(amp, cond) for *_, amp, cond in self._tractions + self._body + self._point_loads
+                + self._dead_pressures] + [(amp, cond) for _, _, amp, cond, _ in self._follower_pressures]
 
     # -- initial (K₀) stress ---------------------------------------------------------------
     initial_stress = None  # σ₀ (UFL) the cells carry at zero strain, or None
@@ -512,7 +562,9 @@ class Solid(AdditiveState, Part):
             if self._shifted:
                 integrand = ufl.det(ufl.Identity(self.gdim) + ufl.grad(self.reference_shift)) * integrand
             residual = integrand * dx
-            jacobian = ufl.derivative(residual, u, du)
+            load = self._follower_load(u, v)
+            # the tangent of f_int − f_load(u): the load stiffness of follower pressures
+            jacobian = ufl.derivative(residual if load is None else residual - load, u, du)
             self._forms = (dolfinx.fem.form(residual), dolfinx.fem.form(jacobian))
         return self._forms
 
@@ -537,6 +589,15 @@ class Solid(AdditiveState, Part):
                     if self.existing is not None:  # on the faces of existing cells
                         term = self.existing * term
                     terms.append((term if area is None else area * term) * ds(tag))
+        if any(a is amplitude and cond.exists for _, _, a, cond in self._dead_pressures):
+            ds = ufl.Measure("ds", domain=self.V.mesh, subdomain_data=self.tmesh.facet_tags)
+            N = ufl.FacetNormal(self.V.mesh)
+            for where, p, amp, cond in self._dead_pressures:
+                if amp is amplitude and cond.exists:
+                    term = -p * ufl.inner(N, v)
+                    if self.existing is not None:
+                        term = self.existing * term
+                    terms.append((term if area is None else area * term) * ds(self.tmesh.groups[where][1]))
         dx = ufl.Measure("dx", domain=self.V.mesh, subdomain_data=self.tmesh.cell_tags)
         for where, b, material_density, amp, cond in self._body:
             if amp is amplitude and cond.exists:

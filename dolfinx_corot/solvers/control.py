@@ -468,6 +468,10 @@ class ArcLength:
         if system.has_prescribed_motion:
             raise NotImplementedError("arc-length with prescribed displacements is not supported; "
                                       "follow them with LoadControl (displacement control)")
+        if run.scene.follower_loads:
+            raise NotImplementedError("arc-length with follower loads (pressures, follower loads per length) is not "
+                                      "supported: its reference load would change with the configuration; follow "
+                                      "them with LoadControl or displacement control")
         if system.reference_load_norm == 0.0:
             raise ValueError("arc-length needs a reference load: the scene has no loads proportional to λ")
         if system.amplitude_loads:

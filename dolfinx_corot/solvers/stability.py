@@ -327,7 +327,8 @@ class StabilityTracker:
         self.mode = mode
         self.free = system.counts_inertia
         size = system.A.getSize()[0]
-        self.enabled = mode == "on" or (mode == "auto" and (self.free or size <= max_dofs))
+        self._small = size <= max_dofs
+        self.enabled = mode == "on" or (mode == "auto" and (self.free or self._small))
         if mode == "auto" and not self.enabled:
             logger.info("critical points are not tracked: the tangent (%d dofs) is not factorized by LDLᵀ and "
                         "counting its inertia separately would cost a factorization per step", size)
@@ -343,6 +344,11 @@ class StabilityTracker:
         if not self.enabled:
             return None, None, False
         system = self.system
+        # the solver may have turned from LDLᵀ to LU (a contribution with an unsymmetric tangent
+        # engaged: mortar contact, follower loads): then the symmetric part is factorized apart
+        self.free = system.counts_inertia
+        if not self.free and not (self.mode == "on" or self._small):
+            return None, None, False
         counts, signs = system.take_inertia()
         before = self.negative
         reusable = system.tangent_reusable

@@ -344,11 +344,12 @@ class StabilityTracker:
         if not self.enabled:
             return None, None, False
         system = self.system
-        # the solver may have turned from LDLᵀ to LU (a contribution with an unsymmetric tangent
-        # engaged: mortar contact, follower loads): then the symmetric part is factorized apart
-        self.free = system.counts_inertia
-        if not self.free and not (self.mode == "on" or self._small):
-            return None, None, False
+        # follower loads turn the solver from LDLᵀ to LU (their load stiffness is not symmetric):
+        # the symmetric part is then factorized apart, as for any LU system
+        if system.fload is not None:
+            self.free = system.counts_inertia
+            if not self.free and not (self.mode == "on" or self._small):
+                return None, None, False
         counts, signs = system.take_inertia()
         before = self.negative
         reusable = system.tangent_reusable

@@ -59,6 +59,7 @@ comm = MPI.COMM_WORLD
 L, DEPTH, E_BEAM = 2.0, 0.3, 3.0e5
 E_SOIL, NU = 1.0e4, 0.3
 F, STEPS = 600.0, 6
+SCALE = 10.0  # the pictures' displacement magnification
 
 
 # %% [markdown]
@@ -95,6 +96,10 @@ def scene(h: float, setting: str):
 
 # %% [markdown]
 # ## Runs: three settings on two meshes
+#
+# The symmetric setting on the fine mesh (run under CI too) is pictured at F = 100, 200, 400
+# and 600 (`footing_shapes.png`): the footing sinking into the soil, displacements magnified
+# ten times and coloured by their magnitude, the undeformed outline in grey.
 
 # %%
 meshes = {"coarse": 1 / 8, "fine": 1 / 16}
@@ -115,7 +120,10 @@ def runs(demo):
             if demo.ci and mesh_name == "fine" and setting != "symmetric":
                 continue
             sc, made = scene(h, setting)
-            res, wall = timed(dc.solve, sc, dc.LoadControl(steps=STEPS))
+            shots = None
+            if (mesh_name, setting) == ("fine", "symmetric"):  # the pictures: the run made in every mode
+                shots = dc.plot.Snapshots(sc, at=(1 / 6, 1 / 3, 2 / 3, 1.0))
+            res, wall = timed(dc.solve, sc, dc.LoadControl(steps=STEPS), on_step=shots)
             hist = res.history
             pressure = made.pressure(footing_side(setting)).normal_force
             row = {"mesh": mesh_name, "h": h, "setting": setting, "settlement": -float(hist.column("mid_uy")[-1]),
@@ -124,6 +132,11 @@ def runs(demo):
                    "max_uzawa": int(hist.column("uzawa_updates").max()), "wall_s": wall}
             rows.append(row)
             profiles[(mesh_name, setting)] = made.pressure(footing_side(setting), current=True)
+            if shots is not None:
+                for state in shots.states:
+                    state.label = f"F = {F * state.load_factor:.0f}"
+                demo.picture(shots, "footing_shapes.png", scale=SCALE, columns=2, window_size=(1400, 900),
+                             show_edges=False, title=f"{mesh_name} mesh, {setting}")
             demo.say(f"{mesh_name:6s} {setting:9s}: settlement {row['settlement']:.5f}, "
                      f"base reaction {row['base_Fy']:.8f}, "
                      f"Σ p L = {pressure:.6f}; {row['newton_iterations']} Newton its, {row['cuts']} cuts, "

@@ -89,6 +89,7 @@ STEPS = PRESS_STEPS + PUSH_STEPS
 PRESSED = PRESS_STEPS / STEPS  # the load factor at the end of the pressing
 A_HERTZ = 0.044  # about a, for the meshes' sizes
 SLIP_TOLERANCE = 1e-3  # the tangential Uzawa updates' (× the mean segment); None: the penalty alone
+PICTURED, SCALE = (0.25, 0.5, 0.75, 1.0), 50.0  # the pictures' load factors and displacement magnification
 
 
 # %% [markdown]
@@ -147,10 +148,15 @@ def mesh(h: float):
 # ## The contact problem
 # Four steps of pressing, four of pushing; after each push, the pressures and
 # the friction tractions of the slaves are kept (`Interface.pressure`,
-# `Interface.friction_traction`).
+# `Interface.friction_traction`). On the mesh a/20 the bodies are pictured half
+# pressed, pressed, half pushed and pushed (`cattaneo_mindlin_shapes.png`,
+# displacements × 50 coloured by their magnitude, the undeformed outline in grey):
+# the cylinder flattens on the dented block, then moves sideways.
 
 # %%
-def run(h: float, slip_tolerance: float | None = SLIP_TOLERANCE):
+def run(h: float, slip_tolerance: float | None = SLIP_TOLERANCE, shots_at: tuple | None = None):
+    """The run on the mesh of size h; ``shots_at``: load factors at which dolfinx_corot.plot.Snapshots
+    keeps the scene's state (returned as ``result.shots``)."""
     tm = mesh(h)
     sc = dc.Scene(large_rotations=False)
     cylinder = sc.add_solid(tm, "cylinder", material=dc.Elastic(E, NU), degree=1)
@@ -162,8 +168,11 @@ def run(h: float, slip_tolerance: float | None = SLIP_TOLERANCE):
                         friction=dc.Coulomb(mu=MU, tangential_factor=1.0, slip_tolerance=slip_tolerance))
     sc.monitor_reaction("top", cylinder, "top")
     states = []
+    shots = None if shots_at is None else dc.plot.Snapshots(sc, at=shots_at)
 
     def on_step(row):
+        if shots is not None:
+            shots(row)
         X, p = itf.pressure()
         _, t, slipping = itf.friction_traction()
         if row["load_factor"] < PRESSED + 1e-9:  # pressing
@@ -175,7 +184,18 @@ def run(h: float, slip_tolerance: float | None = SLIP_TOLERANCE):
                        "load_factor": row["load_factor"]})
 
     result, wall = timed(dc.solve, sc, dc.LoadControl(steps=STEPS), on_step=on_step)
+    result.shots = shots
     return result, states, wall
+
+
+def picture(demo, shots, h: float):
+    """The bodies half pressed, pressed, half pushed and pushed (``cattaneo_mindlin_shapes.png``)."""
+    for state in shots.states:
+        lam = state.load_factor
+        press, push = PRESS * min(lam / PRESSED, 1.0), PUSH * max(lam - PRESSED, 0.0) / (1.0 - PRESSED)
+        state.label = f"λ = {lam:g}: top down {press:g}, sideways {push:g}"
+    demo.picture(shots, "cattaneo_mindlin_shapes.png", scale=SCALE, columns=2, window_size=(1500, 1000),
+                 title=f"h = a/{A_HERTZ / h:.0f}")
 
 
 def ellipse(x, p):
@@ -210,7 +230,10 @@ def study(demo):
     for h in sizes + (None,):
         alone = h is None
         h = A_HERTZ / 20 if alone else h
-        result, states, wall = run(h, None if alone else SLIP_TOLERANCE)
+        pictured = not alone and h == A_HERTZ / 20  # the pictures: a/20, run in every mode
+        result, states, wall = run(h, None if alone else SLIP_TOLERANCE, PICTURED if pictured else None)
+        if pictured:
+            picture(demo, result.shots, h)
         history = result.history
         its = history.column("iterations")
         pressing_cuts = history.column("cuts")[history.column("load_factor") < PRESSED + 1e-9].sum()

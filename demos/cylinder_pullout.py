@@ -47,7 +47,9 @@ R, L, t, E, nu = 4.953, 10.35, 0.094, 10.5e6, 0.3125
 P_end = 40000.0
 
 
-def pullout(n_theta, n_x, w_max=3.0, steps=30, membrane="opt"):
+def pullout(n_theta, n_x, w_max=3.0, steps=30, membrane="opt", demo=None):
+    """(P, w_A, w_B, u_C) per step, the result and the wall time; with ``demo``, the cylinder at
+    w_A = 0.75, 1.5, 2.25 and 3 in ``cylinder_shapes.png``."""
     scene = dc.Scene(large_rotations=True)
     shell = scene.add_shell(cylinder_eighth(R, L, n_theta, n_x, comm=comm), "shell", thickness=t,
                             material=dc.Elastic(E, nu), membrane=membrane)
@@ -58,7 +60,12 @@ def pullout(n_theta, n_x, w_max=3.0, steps=30, membrane="opt"):
     scene.monitor_reaction("A", shell, "A")
     for name in "ABC":
         scene.monitor(name, shell, name)
-    res, wall = timed(dc.solve, scene, dc.LoadControl(steps=steps))
+    shots = dc.plot.Snapshots(scene, at=(0.25, 0.5, 0.75, 1.0)) if demo is not None else None
+    res, wall = timed(dc.solve, scene, dc.LoadControl(steps=steps), on_step=shots)
+    if demo is not None:  # the last state first: the views share the first one's camera
+        demo.picture(shots.states[::-1], "cylinder_shapes.png", field="displacement", layout="grid", columns=2,
+                     window_size=(1200, 1000),
+                     title=f"Cylinder pull-out ({n_theta} x {n_x} mesh), w_A = 3, 2.3, 1.5, 0.8")
     h = res.history
     curve = np.c_[4.0 * h.column("A_Fz"), h.column("A_uz"), h.column("B_uz"), h.column("C_uy")]
     return curve, res, wall
@@ -75,6 +82,10 @@ def at_wA(curve, w):
 
 # %% [markdown]
 # ## Three meshes (n_θ × n_x triangles pairs)
+#
+# `cylinder_shapes.png` draws the finest OPT model at $w_A$ = 3, 2.3, 1.5 and 0.8 (from the
+# last state back), coloured by $|u|$ over the initial eighth of the cylinder: the section is
+# pulled from a quarter circle into a flat band.
 
 # %%
 def three_meshes(demo):
@@ -85,7 +96,8 @@ def three_meshes(demo):
     for membrane in ("opt", "cst"):
         rows = []
         for n_theta, n_x in meshes:
-            curve, res, wall = pullout(n_theta, n_x, membrane=membrane)
+            finest_opt = membrane == "opt" and (n_theta, n_x) == meshes[-1]  # the picture of this run
+            curve, res, wall = pullout(n_theta, n_x, membrane=membrane, demo=demo if finest_opt else None)
             if membrane == "opt":
                 curves[(n_theta, n_x)] = curve
             d = at_wA(curve, W_CHECK)

@@ -77,7 +77,8 @@ def column_mesh():
 #
 # The reference load is $N_{cr}$ downwards with the moment $N_{cr}e$; the load
 # factor $\lambda = N/N_{cr}$ runs from 0 to 4 in steps of 0.1 (the reference
-# points).
+# points). `euler_beam_2d_shapes.png` draws the deformed column at
+# $N/N_{cr}$ = 1, 1.5, 2, 3 and 4 over its straight initial shape, coloured by $|u|$.
 
 # %%
 def build_scene(tmesh, large_rotations=True, kinematics="bernoulli"):
@@ -95,17 +96,21 @@ def load_path(demo, tmesh):
     scene = build_scene(tmesh)
     demo.say("effects:", scene.effects())
     shapes = {}
+    pictures = dc.plot.Snapshots(scene, at=(1.0, 1.5, 2.0, 3.0, 4.0))  # PyVista states
 
     def snapshot(row):
-        """Keep the deformed column at a few load levels for the plot."""
+        """Keep the deformed column at a few load levels for the plots."""
         if any(abs(row["load_factor"] - v) < 1e-9 for v in (1.0, 1.5, 2.0, 3.0, 4.0)):
             X, state = scene.model.nodes()
             order = np.argsort(X[:, 1])
             shapes[round(row["load_factor"], 3)] = (X + state[:, :2])[order]
+        pictures(row)
 
     result, wall = timed(dc.solve, scene, dc.LoadControl(steps=40, final=4.0), on_step=snapshot)
     demo.write_result(result)
     demo.say(f"{len(result.history)} steps, {result.totals['newton_iterations']} Newton iterations, {wall:.2f} s")
+    demo.picture(pictures, "euler_beam_2d_shapes.png", field="displacement",
+                 title="Euler column: N/N_cr = 1, 1.5, 2, 3, 4", window_size=(1000, 800))
     return result.history, shapes
 
 

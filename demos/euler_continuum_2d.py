@@ -90,15 +90,20 @@ def column(nx: int, ny: int):
 # default for continua: past the bifurcation the tangent of the coarsest
 # meshes is nearly singular and CG with GAMG stalls, and the LDLᵀ inertia
 # shows that the path followed is stable (no negative pivot).
+#
+# `euler_continuum_2d_shapes.png` draws the Q9 40 × 4 column (the recorded run) pushed by
+# 0.2, 0.4, 0.6 and 1 m over its initial outline, coloured by $|u|$.
 
 # %%
 SHORTENING = 1.0
 LOAD_FACTORS = list(np.r_[np.linspace(0.0, 0.04, 81)[1:], np.linspace(0.04, SHORTENING, 25)[1:]] / SHORTENING)
 
 
-def compress(tm, degree: int, clamp: str):
+def compress(tm, degree: int, clamp: str, picture=None):
     """The column of mesh ``tm`` (cell group "weak", point group "tip"), clamped on ``clamp`` and
-    pushed at "tip": (scene, result, wall time)."""
+    pushed at "tip": (scene, result, wall time). ``picture``: (demo, file name, options of
+    ``demo.picture``) to draw the column at a push of 1, 0.6, 0.4 and 0.2 m (the last state first:
+    the views of a grid share the first one's camera)."""
     scene = dc.Scene(large_rotations=True, linear_solver="direct")
     col = scene.add_solid(tm, material=dc.SaintVenantKirchhoff(E, 0.0), degree=degree)
     scene.add_solid(tm, "weak", material=dc.SaintVenantKirchhoff(0.5 * E, 0.0), degree=degree)
@@ -108,7 +113,12 @@ def compress(tm, degree: int, clamp: str):
     scene.monitor_reaction("tip", col, "tip")
     # the path is traced through and past buckling on purpose: critical points are recorded
     # (result.critical_points), not a reason to stop
-    res, wall = timed(dc.solve, scene, dc.LoadControl(load_factors=LOAD_FACTORS, at_critical_point="continue"))
+    shots = dc.plot.Snapshots(scene, at=np.array([0.2, 0.4, 0.6, 1.0]) / SHORTENING) if picture else None
+    res, wall = timed(dc.solve, scene, dc.LoadControl(load_factors=LOAD_FACTORS, at_critical_point="continue"),
+                      on_step=shots)
+    if picture:
+        demo, filename, options = picture
+        demo.picture(shots.states[::-1], filename, **options)
     return scene, res, wall
 
 
@@ -137,7 +147,11 @@ def work_precision(demo):
         studies = [(10, 2, 2), (20, 2, 2), (40, 4, 2), (80, 8, 1), (160, 16, 1)]
     rows, curves = [], {}
     for nx, ny, degree in studies:
-        scene, res, wall = compress(column(nx, ny), degree, "clamp")
+        picture = None
+        if (nx, ny, degree) == (40, 4, 2):  # the recorded mesh: its picture
+            picture = (demo, "euler_continuum_2d_shapes.png",
+                       dict(field="displacement", layout="overlay", title=f"Q9 {nx} x {ny}: push 1, 0.6, 0.4, 0.2 m"))
+        scene, res, wall = compress(column(nx, ny), degree, "clamp", picture)
         Pcr, npts = critical_load(res)
         err = (Pcr - P_ref) / P_ref
         h = res.history

@@ -51,7 +51,11 @@
 #
 # Written: `stages.csv` (per stage: steps, Newton iterations, base reaction and the weight,
 # contact force, roof deflection, largest moment in the frame), `stage_<k>.png` (each stage's
-# configuration, soil coloured by vertical stress) and `frame_filling_1.png`.
+# configuration, soil coloured by vertical stress), `frame_filling_1_stages.png` (PyVista: the
+# ground, fill and frame that exist at the end of each stage after the geostatic one,
+# displacements × 50 coloured by their magnitude, the undeformed shape in grey: the pit's
+# floor heaving when it is dug, the fill settling as the layers are placed) and
+# `frame_filling_1.png`.
 
 # %%
 import logging
@@ -144,12 +148,15 @@ def frame_state(setup) -> dict:
                 max_moment=float(frame.comm.allreduce(moment, op=max)))
 
 
-def run(demo, setup, approach: str, snapshots: dict | None = None) -> dict:
+def run(demo, setup, approach: str, snapshots: dict | None = None, shots=None) -> dict:
     """The stages with ``approach``; per stage its row and the configuration at its end (kept in
-    ``snapshots``, also when a stage fails)."""
+    ``snapshots``, also when a stage fails; ``shots``: a dolfinx_corot.plot.Snapshots of the scene
+    also called at every step, for PyVista pictures)."""
     snapshots = {} if snapshots is None else snapshots
 
     def keep(stage, row):
+        if shots is not None:
+            shots(stage, row)
         snapshots[stage.name] = dict(soil=setup["soil"].model.cell_shapes(),
                                      frame=setup["frame"].model.cell_shapes(),
                                      slab=setup["slab"].model.cell_shapes(),
@@ -211,6 +218,18 @@ def draw_stages(demo, out, scale: float, prefix: str = "stage") -> None:
         demo.save(fig, f"{prefix}_{k}.png", dpi=90)
 
 
+def picture_stages(demo, shots, filename: str, approach: str, scale: float, names: dict | None = None,
+                   **options) -> None:
+    """The PyVista picture of the state at the end of every stage but the geostatic one (whose
+    displacements are discarded), coloured by |u|: ``shots`` a dolfinx_corot.plot.Snapshots given
+    to :func:`run`; ``names``: the stages' names to show instead of some."""
+    states = [state for state in shots.states if state.label != "geostatic"]
+    for state in states:
+        name = (names or {}).get(state.label, state.label)
+        state.label = f"after '{name}'"
+    demo.picture(states, filename, scale=scale, title=f"approach {approach}", **options)
+
+
 def plot(demo, out, setup) -> None:
     rows = out["rows"]
     fig, ax = demo.figure(1, 2, figsize=(11.0, 4.0))
@@ -251,9 +270,11 @@ def main() -> dict:
     demo = Demo("frame_filling_1")
     setup = build("structure")
     demo.say("effects:", setup["scene"].effects())
-    out = run(demo, setup, "I")
+    shots = dc.plot.Snapshots(setup["scene"])  # the end of every stage
+    out = run(demo, setup, "I", shots=shots)
     demo.table("stages.csv", out["rows"])
     draw_stages(demo, out, scale=50.0)
+    picture_stages(demo, shots, "frame_filling_1_stages.png", "I", scale=50.0, columns=3, window_size=(1800, 1250))
     plot(demo, out, setup)
     rows = out["rows"]
     verify_common(demo, out, setup)

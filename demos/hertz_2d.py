@@ -62,6 +62,7 @@ ref = reference("B5_hertz_line_contact")
 cases = [c for c in ref["cases"] if c["config"] == "elastic cylinder on rigid flat"]
 R, E, NU = cases[0]["R1"], cases[0]["E1"], cases[0]["nu1"]
 MATERIAL = dc.NeoHookean
+PICTURED = "dense foundation h=0.08"  # the mesh whose deformation is pictured
 
 
 # %% [markdown]
@@ -124,6 +125,11 @@ def mesh(h_contact: float, h_foundation: float):
 # at F = 50 and F = 100. The augmented Lagrangian updates the contact
 # pressures after each converged Newton solve until the gap of every node in
 # contact is below 1e-4 of the master segments' mean length.
+#
+# `hertz_2d_shapes.png` shows the half model on the dense foundation h = 0.08 at F = 20, 50 and
+# 100, at true scale and coloured by the displacement's magnitude (the undeformed outline in
+# grey): the cylinder flattens on the foundation and bulges sideways, the stiff foundation
+# hardly moves.
 
 # %%
 def hertz_fit(x, p):
@@ -134,7 +140,9 @@ def hertz_fit(x, p):
     return np.sqrt(a), np.sqrt(a / -c)
 
 
-def run(name: str, h_contact: float, h_foundation: float, steps: int):
+def run(name: str, h_contact: float, h_foundation: float, steps: int, shots_at: tuple | None = None):
+    """The run on one mesh; ``shots_at``: load factors at which a dolfinx_corot.plot.Snapshots keeps
+    the scene's state (returned as ``res.shots``)."""
     tm = mesh(h_contact, h_foundation)
     sc = dc.Scene()
     body = sc.add_solid(tm, material=MATERIAL(E, NU), degree=1)
@@ -147,8 +155,11 @@ def run(name: str, h_contact: float, h_foundation: float, steps: int):
                         law=dc.AugmentedLagrangian(gap_tolerance=1e-4))
     sc.monitor("top", body, "load", reduce="mean")         # the loaded edge's mean displacement
     profiles = {}
+    shots = None if shots_at is None else dc.plot.Snapshots(sc, at=shots_at)
 
     def on_step(row):
+        if shots is not None:
+            shots(row)
         F = 100.0 * row["load_factor"]
         if any(abs(F - c["F"]) < 1e-9 for c in cases):
             x, p = itf.pressure(current=True)
@@ -156,6 +167,7 @@ def run(name: str, h_contact: float, h_foundation: float, steps: int):
             profiles[F] = {"slave": (x[:, 0], p), "master": (xm[:, 0], pm)}
 
     res, wall = timed(dc.solve, sc, dc.LoadControl(steps=steps), on_step=on_step)
+    res.shots = shots
     return res, profiles, wall, sc
 
 
@@ -170,7 +182,13 @@ def hertz_study(demo):
     pressure profiles per mesh."""
     rows, results = [], {}
     for name, hc, hf in meshes(demo):
-        res, profiles, wall, sc = run(name, hc, hf, steps=10)
+        pictured = name == PICTURED  # the pictures: a mesh run in every mode
+        res, profiles, wall, sc = run(name, hc, hf, steps=10, shots_at=(0.2, 0.5, 1.0) if pictured else None)
+        if pictured:
+            for state in res.shots.states:
+                state.label = f"F = {100.0 * state.load_factor:g}"
+            demo.picture(res.shots, "hertz_2d_shapes.png", columns=3, window_size=(1800, 650),
+                         title=f"{name}, true scale")
         its = res.history.column("iterations")
         uz = res.history.column("uzawa_updates")
         for F, prof in profiles.items():

@@ -43,6 +43,7 @@ from dolfinx_corot.io.mesh import name_groups
 comm = MPI.COMM_WORLD
 R, E, NU, F = 10.0, 1000.0, 0.3, 300.0
 E_STAR = E / (1.0 - NU**2)
+PICTURED = 0.2  # the mesh (h_c) whose deformation is pictured: run in every mode
 
 
 def hertz(force: float) -> tuple[float, float]:
@@ -95,6 +96,11 @@ def mesh(h_contact: float):
 
 # %% [markdown]
 # ## The contact problem and Hertz's ellipse
+#
+# On the mesh h_c = 0.2 the quarter model is pictured at λ = 0.2, 0.6 and 1
+# (`hertz_3d_shapes.png`, true scale, coloured by the displacement's magnitude, the undeformed
+# outline in grey), seen from the side of the symmetry planes: the sphere sinks onto the block,
+# its mesh refined round the contact point.
 
 # %%
 def hertz_fit(r, p):
@@ -105,7 +111,9 @@ def hertz_fit(r, p):
     return np.sqrt(c0), np.sqrt(c0 / -c1)
 
 
-def run(h_contact: float, steps: int = 5) -> dict:
+def run(h_contact: float, steps: int = 5, shots_at: tuple | None = None) -> dict:
+    """The run on one mesh; ``shots_at``: load factors at which a dolfinx_corot.plot.Snapshots keeps
+    the scene's state (then returned as ``shots``)."""
     tm = mesh(h_contact)
     sc = dc.Scene(large_rotations=True, linear_solver="direct")
     ball = sc.add_solid(tm, "sphere", material=dc.NeoHookean(E, NU), degree=1)
@@ -117,7 +125,8 @@ def run(h_contact: float, steps: int = 5) -> dict:
     pair = sc.contact((ball, "ball"), (block, "ground"), law=dc.AugmentedLagrangian(gap_tolerance=1e-4))
     sc.monitor_contact("contact", pair)
     sc.monitor_reaction("base", block, "bottom")
-    res, wall = timed(dc.solve, sc, dc.LoadControl(steps=steps))
+    shots = None if shots_at is None else dc.plot.Snapshots(sc, at=shots_at)
+    res, wall = timed(dc.solve, sc, dc.LoadControl(steps=steps), on_step=shots)
     row = res.history.rows[-1]
     force = 4.0 * row["base_Fz"]  # the load the mesh applies (quarter model)
     p = pair.pressure("slaves")
@@ -129,7 +138,7 @@ def run(h_contact: float, steps: int = 5) -> dict:
             "p0_error": p0 / p0_h - 1.0, "a_error": a / a_h - 1.0, "p_max_node": float(p.pressure.max()),
             "wall_s": wall, "newton_iterations": int(res.history.column("iterations").sum()),
             "uzawa_updates": int(res.history.column("uzawa_updates").sum()), "cuts": int(res.history.column("cuts").sum()),
-            "profile": (r, p.pressure)}
+            "profile": (r, p.pressure), **({} if shots is None else {"shots": shots})}
 
 
 # %% [markdown]
@@ -141,7 +150,14 @@ def main() -> dict:
     sizes = (0.3, 0.2) if demo.ci else (0.3, 0.2, 0.14)
     rows = []
     for h in sizes:
-        out = run(h)
+        out = run(h, shots_at=(0.2, 0.6, 1.0) if h == PICTURED else None)
+        if "shots" in out:
+            shots = out.pop("shots")
+            for state in shots.states:
+                state.label = f"λ = {state.load_factor:g}, F ≈ {F * state.load_factor:g}"
+            demo.picture(shots, "hertz_3d_shapes.png", window_size=(1800, 650), show_edges=True,
+                         title=f"h_c = {h:g}, true scale",
+                         camera=[(-25.0, -15.0, 12.0), (5.0, 5.0, 0.0), (0.0, 0.0, 1.0)])  # onto the cuts
         rows.append(out)
         demo.say(f"h_c = {h:4.2f}: {out['dofs']:6d} dofs, F = {out['force']:.2f}: p0 = {out['p0']:.2f} (Hertz "
                  f"{out['p0_hertz']:.2f}, {100 * out['p0_error']:+.2f} %), a = {out['a']:.4f} (Hertz {out['a_hertz']:.4f}, "

@@ -54,7 +54,9 @@ def quarter_cap(n):
     return from_arrays(pts, cells, "cap", groups, comm=comm)
 
 
-def sphere(n, steps=40):
+def sphere(n, steps=40, demo=None):
+    """(w, P) from the unloaded state, the result and the wall time; with ``demo``, the cap at
+    w = 0.5, 1, 1.5 and 2.5 h in ``cap_shapes.png``."""
     scene = dc.Scene(large_rotations=True)
     cap = scene.add_shell(quarter_cap(n), "cap", thickness=t, material=dc.Elastic(E, nu))
     scene.fix(cap, "sym_x", dofs=("ux", "ry", "rz"))
@@ -62,7 +64,12 @@ def sphere(n, steps=40):
     scene.fix(cap, "edges", dofs=("ux", "uy", "uz"))  # hinged
     scene.prescribe(cap, "centre", uz=-2.5 * h)
     scene.monitor_reaction("centre", cap, "centre")
-    res, wall = timed(dc.solve, scene, dc.LoadControl(steps=steps))
+    shots = dc.plot.Snapshots(scene, at=(0.2, 0.4, 0.6, 1.0)) if demo is not None else None
+    res, wall = timed(dc.solve, scene, dc.LoadControl(steps=steps), on_step=shots)
+    if demo is not None:  # the last state first (the views share the first one's camera), seen from −y
+        demo.picture(shots.states[::-1], "cap_shapes.png", field="displacement", layout="grid", columns=2,
+                     window_size=(1300, 850), camera=[(20.0, -45.0, 12.0), (7.5, 7.5, 0.0), (0.0, 0.0, 1.0)],
+                     title=f"Hinged cap ({n} x {n} quarter), w = 2.5, 1.5, 1, 0.5 h")
     w = np.r_[0.0, 2.5 * h * res.history.column("load_factor")]
     P = np.r_[0.0, -4.0 * res.history.column("centre_Fz")]  # the whole cap: four quarters
     return w, P, res, wall
@@ -70,6 +77,10 @@ def sphere(n, steps=40):
 
 # %% [markdown]
 # ## Three meshes
+#
+# `cap_shapes.png` draws the quarter cap of the finest mesh at central displacements of
+# 2.5, 1.5, 1 and 0.5 $h$ (from the last state back; the centre is the left corner), coloured by
+# $|u|$ over its initial outline: from the dent before the snap to the inverted cap.
 
 # %%
 def three_meshes(demo):
@@ -77,7 +88,7 @@ def three_meshes(demo):
     iterations in a step) and the force–displacement curves."""
     study, curves = [], {}
     for n in ([6, 8, 12] if demo.ci else [8, 12, 16]):
-        w, P, res, wall = sphere(n)
+        w, P, res, wall = sphere(n, demo=demo if n == (12 if demo.ci else 16) else None)  # a picture of the finest
         curves[n] = (w, P)
         P_max = limit_load(P, w)
         k = int(np.flatnonzero(np.diff(P) < 0)[0]) + 1

@@ -76,6 +76,7 @@ DEPTH, SLIDE = 0.2, 2.0
 PRESS_STEPS = 8
 STEADY_FROM = 0.5  # the die has slid this far: past the transient of the start of sliding
 SLIP_TOLERANCE = 1e-3
+PICTURED = 0.05  # the mesh whose deformation is pictured (run in every mode)
 
 
 # %% [markdown]
@@ -116,10 +117,17 @@ def mesh(h: float):
 
 # %% [markdown]
 # ## The scene: press, then slide
+#
+# On the mesh h = 0.05 the bodies are pictured half pressed, pressed, and slid by 1 and by 2
+# (`ironing_2d_shapes.png`, true scale, coloured by the displacement's magnitude up to 0.25 —
+# the die, slid further, is off the scale —, the undeformed outline in grey): the die ploughs
+# a trough that the block recovers behind it.
 
 # %%
-def run(h: float, slip_tolerance: float | None = SLIP_TOLERANCE):
-    """The ironing run on the mesh of size h; returns (result, the last step's slaves, wall time)."""
+def run(h: float, slip_tolerance: float | None = SLIP_TOLERANCE, shots_at: tuple | None = None):
+    """The ironing run on the mesh of size h; returns (result, the last step's slaves, wall time).
+    ``shots_at``: the die's slides (−1: half pressed) at which a dolfinx_corot.plot.Snapshots keeps
+    the scene's state (returned as ``result.shots``)."""
     tm = mesh(h)
     slide_steps = round(SLIDE / h)
     steps = PRESS_STEPS + slide_steps
@@ -133,7 +141,12 @@ def run(h: float, slip_tolerance: float | None = SLIP_TOLERANCE):
     (itf,) = sc.contact((block, "block_top"), (die, "arc"), law=dc.AugmentedLagrangian(),
                         friction=dc.Coulomb(mu=MU, slip_tolerance=slip_tolerance))
     sc.monitor_reaction("die", die, "die_top")
-    result, wall = timed(dc.solve, sc, dc.LoadControl(steps=steps))
+    shots = None
+    if shots_at is not None:
+        shots = dc.plot.Snapshots(sc, at=[0.5 * pressed if s < 0 else pressed + (1 - pressed) * s / SLIDE
+                                          for s in shots_at])
+    result, wall = timed(dc.solve, sc, dc.LoadControl(steps=steps), on_step=shots)
+    result.shots = shots
     _, p = itf.pressure()
     _, t, slipping = itf.friction_traction()
     return result, (p, t, slipping), wall
@@ -150,10 +163,19 @@ def study(demo):
     sizes = (0.1, 0.05) if demo.ci else (0.1, 0.05, 0.025)
     rows, histories = [], {}
     for h in sizes:
-        result, (p, t, slipping), wall = run(h)
+        pictured = h == PICTURED
+        result, (p, t, slipping), wall = run(h, shots_at=(-1.0, 0.0, 1.0, 2.0) if pictured else None)
         history = result.history
         lf = history.column("load_factor")
         pressed = PRESS_STEPS / (PRESS_STEPS + round(SLIDE / h))
+        if pictured:
+            for state in result.shots.states:
+                lam = state.load_factor
+                state.label = (f"pressed {DEPTH * min(lam / pressed, 1.0):.2g} deep, "
+                               f"slid {SLIDE * max(lam - pressed, 0.0) / (1.0 - pressed):.2g}")
+            demo.picture(result.shots, "ironing_2d_shapes.png", columns=2, window_size=(1600, 1000), show_edges=False,
+                         clim=(0.0, 0.25),  # (the block's range: the die's slide is off the scale)
+                         title=f"h = {h:g}, true scale")
         slid = SLIDE * np.clip((lf - pressed) / (1.0 - pressed), 0.0, None)
         Fx, Fy = history.column("die_Fx"), history.column("die_Fy")
         ratio = -Fx / Fy  # (the block pushes the die back, against the slide, and up)

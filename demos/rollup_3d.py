@@ -79,12 +79,17 @@ def skew_cantilever():
 
 # %% [markdown]
 # ## Two turns in 40 load steps
+#
+# `rollup_3d_shapes.png` draws the beam at $M$ = 0.25, 0.5, 1, 1.5 and 2 × $2\pi EI/L$, seen
+# along the moment's axis $\mathbf n$, coloured by the angle of the nodal rotations (a rotation
+# vector's, between 0 and π: it returns to 0 at every full turn).
 
 # %%
 def two_turns(demo, scene, system):
     """The history, the deformed beam at every step and the state at half a turn."""
     shapes = {}
     half_turn_state = {}
+    pictures = dc.plot.Snapshots(scene, at=(0.25, 0.5, 1.0, 1.5, 2.0))  # PyVista states
 
     def snapshot(row):
         X, state = scene.model.nodes()
@@ -92,6 +97,7 @@ def two_turns(demo, scene, system):
         shapes[round(row["load_factor"], 3)] = (X + state[:, :3])[order]
         if abs(row["load_factor"] - 0.5) < 1e-12:
             half_turn_state["x"] = scene.model.checkpoint()
+        pictures(row)
 
     # the perfect beam stays on the circle; where the tangent loses definiteness the point is
     # recorded and load control goes on (the closed form is the path followed)
@@ -105,6 +111,10 @@ def two_turns(demo, scene, system):
                  "along the circle")
     demo.say(f"{len(hist)} steps, {result.totals['newton_iterations']} Newton iterations, {wall:.2f} s; "
              f"iterations per step {int(hist.column('iterations').min())}-{int(hist.column('iterations').max())}")
+    # seen along the moment's axis n, the beam's axis a upwards: the circles face the camera
+    demo.picture(pictures, "rollup_3d_shapes.png", field="rotation", window_size=(1000, 800),
+                 camera=[tuple(x0 + 40 * n), tuple(x0), tuple(a)],
+                 title="Skew roll-up, M = 0.25, 0.5, 1, 1.5, 2 × 2πEI/L (seen along n)")
     return hist, shapes, half_turn_state["x"]
 
 

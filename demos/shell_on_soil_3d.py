@@ -54,6 +54,7 @@ E, NU, SIDE, DEPTH = 100.0, 0.3, 1.0, 0.5  # the soil block (quarter: [0, 1]² �
 E_PLATE, T, HALF, DELTA = 2e4, 0.05, 0.3, 0.15  # the plate: modulus, thickness, half side; the push
 M = E * (1.0 - NU) / ((1.0 + NU) * (1.0 - 2.0 * NU))  # the constrained (oedometric) modulus
 BETTI = -DEPTH / (M * SIDE * SIDE)  # the top's mean settlement per unit vertical load (Betti)
+PICTURED = (0.2, 6)  # the meshes pictured (run in every mode)
 
 
 # %% [markdown]
@@ -122,9 +123,12 @@ def plate(n: int):
 # ## The scene: two-pass contact between the plate and the block's top
 
 # %%
-def run(h: float, n: int, steps: int = 10, large: bool = True, delta: float = DELTA) -> dict:
+def run(h: float, n: int, steps: int = 10, large: bool = True, delta: float = DELTA,
+        shots_at: tuple | None = None) -> dict:
     """The plate (n × n squares) pushed by ``delta`` into the block (mesh size h); ``large``: large
-    deformation and a neo-Hookean soil, else small strains and linear elasticity."""
+    deformation and a neo-Hookean soil, else small strains and linear elasticity; ``shots_at``: load
+    factors at which a dolfinx_corot.plot.Snapshots keeps the scene's state (then returned as
+    ``shots``)."""
     sc = dc.Scene(large_rotations=large, linear_solver="direct")
     soil = sc.add_solid(block(h), material=dc.NeoHookean(E, NU) if large else dc.Elastic(E, NU), degree=1)
     sc.fix(soil, "base")
@@ -141,7 +145,8 @@ def run(h: float, n: int, steps: int = 10, large: bool = True, delta: float = DE
     sc.monitor_reaction("push", footing, "centre")
     sc.monitor("corner", footing, "corner")
     sc.monitor("surface", soil, "top", reduce="profile", along="x")
-    res, wall = timed(dc.solve, sc, dc.LoadControl(steps=steps))
+    shots = None if shots_at is None else dc.plot.Snapshots(sc, at=shots_at)
+    res, wall = timed(dc.solve, sc, dc.LoadControl(steps=steps), on_step=shots)
     history = res.history
     force = -history.column("push_Fz")
     # the top's mean settlement at every step (the block's top: the slaves of the second pass)
@@ -161,11 +166,30 @@ def run(h: float, n: int, steps: int = 10, large: bool = True, delta: float = DE
             "corner_uz": float(history.column("corner_uz")[-1]),
             "deepest_penetration": min(comm.allreduce(float(itf.gaps()[1].min(initial=np.inf)), op=MPI.MIN) / itf.h
                                        for itf in sc.interfaces),
-            "share_plate_slaves": passes[0] / sum(passes), "history": history, "force_history": force}
+            "share_plate_slaves": passes[0] / sum(passes), "history": history, "force_history": force,
+            **({} if shots is None else {"shots": shots})}
+
+
+def picture(demo, h: float, n: int, shots) -> None:
+    """The plate pushed 0.3, 0.6 and 1 δ into the block, coloured by |u| and by the rotations
+    (``shell_on_soil_3d_shapes.png``, ``shell_on_soil_3d_rotations.png``), seen from the
+    symmetry planes' side."""
+    for state in shots.states:
+        state.label = f"push {DELTA * state.load_factor:.3g}"
+    camera = [(-2.0, -1.6, 1.6), (0.5, 0.5, 0.25), (0.0, 0.0, 1.0)]
+    for field, name in (("displacement", "shapes"), ("rotation", "rotations")):
+        demo.picture(shots, f"shell_on_soil_3d_{name}.png", field=field, camera=camera, window_size=(1800, 650),
+                     title=f"h = {h:g}, plate {n} × {n}, true scale")
 
 
 # %% [markdown]
 # ## Output: force against push, cost against mesh
+#
+# The run on h = 0.2 with the 6 × 6 plate is pictured at pushes of 0.045, 0.09 and 0.15, true
+# scale, seen from the symmetry planes' side, the undeformed outline in grey: coloured by the
+# displacement's magnitude (`shell_on_soil_3d_shapes.png`: the bowl pressed into the block) and
+# by the rotation's (`shell_on_soil_3d_rotations.png`: the plate dishing round the column, its
+# edges turned by 0.3 rad).
 
 # %%
 def main() -> dict:
@@ -173,7 +197,9 @@ def main() -> dict:
     meshes = ((0.2, 6),) if demo.ci else ((0.2, 6), (0.14, 10))
     rows = []
     for h, n in meshes:
-        out = run(h, n)
+        out = run(h, n, shots_at=(0.3, 0.6, 1.0) if (h, n) == PICTURED else None)
+        if "shots" in out:
+            picture(demo, h, n, out.pop("shots"))
         rows.append(out)
         demo.say(f"h = {h:4.2f}, plate {n} × {n}: {out['dofs']:6d} dofs; column force {out['force']:.4f} at δ = "
                  f"{DELTA}; corner turned {out['corner_rotation']:.3f} rad, its u_z {out['corner_uz']:+.4f}; the top's "

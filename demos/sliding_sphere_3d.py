@@ -127,13 +127,19 @@ def mesh(h_block: float, h_die: float = 0.25):
 
 # %% [markdown]
 # ## The scene: the block's top nodes against the die's faces
+#
+# The run with the smoothed master is pictured with the die pressed, slid half way and slid to
+# the end (`sliding_sphere_3d_shapes.png`, true scale, seen from the symmetry plane, coloured by
+# the displacement's magnitude up to 0.15 — the die's slide is off the scale —, the undeformed
+# outline in grey): the dent travels with the die through the block refined along its path.
 
 # %%
-def slide(tm, smooth: bool, steps: int, friction=None, law=None):
+def slide(tm, smooth: bool, steps: int, friction=None, law=None, watch=None):
     """The die pressed, then slid, in ``steps`` steps (a fifth of them pressing); the block's top
     nodes against the die's faces (``law``: the normal law, dc.Penalty() if None; ``friction``: a
-    dc.Coulomb law, or None). Returns (history, wall time, the block, the contact pair, the die's
-    travel at each step, which steps slide steadily)."""
+    dc.Coulomb law, or None; ``watch``: a function of the scene that returns an ``on_step``
+    callback for the solve, e.g. a dolfinx_corot.plot.Snapshots). Returns (history, wall time, the
+    block, the contact pair, the die's travel at each step, which steps slide steadily)."""
     sc = dc.Scene(large_rotations=True, linear_solver="direct")
     block = sc.add_solid(tm, "block", material=dc.NeoHookean(E, NU), degree=1)
     die = sc.add_solid(tm, "die", material=dc.NeoHookean(E_DIE, NU), degree=1)
@@ -148,11 +154,36 @@ def slide(tm, smooth: bool, steps: int, friction=None, law=None):
     sc.monitor_reaction("die", die, "die_top")
     press = max(2, round(steps * PRESS))
     lams = np.concatenate([np.linspace(0.0, PRESS, press + 1)[1:], np.linspace(PRESS, 1.0, steps - press + 1)[1:]])
-    res, wall = timed(dc.solve, sc, dc.LoadControl(load_factors=list(lams)))
+    res, wall = timed(dc.solve, sc, dc.LoadControl(load_factors=list(lams)),
+                      on_step=None if watch is None else watch(sc))
     h = res.history
     travel = np.array([die_motion(v)[0] for v in h.column("load_factor")])
     steady = (travel >= STEADY[0] - 1e-9) & (travel <= STEADY[1] + 1e-9)
     return h, wall, block, pair, travel, steady
+
+
+class Pictures:
+    """A ``watch`` for :func:`slide`: keeps the scene's state with the die pressed, slid half way
+    and slid to the end (a dolfinx_corot.plot.Snapshots, ``shots``) and draws them."""
+
+    AT = (PRESS, 0.5 * (1.0 + PRESS), 1.0)  # the load factors kept
+
+    def __init__(self):
+        self.shots = None
+
+    def __call__(self, scene):
+        self.shots = dc.plot.Snapshots(scene, at=self.AT)
+        return self.shots
+
+    def picture(self, demo, filename: str, what: str, **options) -> None:
+        """The kept states side by side, seen from the symmetry plane's side, true scale, the colours
+        in the block's range (up to the die's depth: the die's slide is off the scale)."""
+        for state in self.shots.states:
+            ux, uz = die_motion(state.load_factor)
+            state.label = f"die {-uz:.2g} deep, slid {ux:.2g}"
+        camera = [(1.0, -7.0, 1.5), (0.8, 0.6, -0.2), (0.0, 0.0, 1.0)]
+        demo.picture(self.shots, filename, **{"camera": camera, "window_size": (1800, 650), "show_edges": True,
+                                               "clim": (0.0, 1.5 * DEPTH), "title": f"{what}, true scale", **options})
 
 
 def departure(travel: np.ndarray, steady: np.ndarray, values: np.ndarray, scale: float) -> float:
@@ -161,8 +192,8 @@ def departure(travel: np.ndarray, steady: np.ndarray, values: np.ndarray, scale:
     return float(np.abs(values[steady] - trend).max() / scale)
 
 
-def run(tm, smooth: bool, steps: int) -> dict:
-    h, wall, block, pair, travel, steady = slide(tm, smooth, steps)
+def run(tm, smooth: bool, steps: int, watch=None) -> dict:
+    h, wall, block, pair, travel, steady = slide(tm, smooth, steps, watch=watch)
     lam = h.column("load_factor")
     fz, fx = h.column("die_Fz"), h.column("die_Fx")  # the force the support exerts on the die
     mean = float(-fz[steady].mean())
@@ -190,8 +221,9 @@ def main() -> dict:
     h_block, steps = (0.09, 30) if demo.ci else (0.06, 60)
     tm = mesh(h_block)
     rows = []
+    pictures = Pictures()
     for smooth in (False, True):
-        out = run(tm, smooth, steps)
+        out = run(tm, smooth, steps, watch=pictures if smooth else None)
         rows.append(out)
         demo.say(f"{'smoothed' if smooth else 'flat    '} master: {out['dofs']} block dofs; steady sliding: Fz "
                  f"{out['mean_Fz']:.3f}, off its trend by at most {100 * out['Fz_spike']:.2f} %; Fx off its trend by "
@@ -199,6 +231,7 @@ def main() -> dict:
                  f"{out['newton_iterations']} Newton its (at most {out['max_iterations']} a step), {out['cuts']} cuts, "
                  f"{out['wall_s']:.1f} s")
     flat, smooth = rows
+    pictures.picture(demo, "sliding_sphere_3d_shapes.png", "smoothed master, frictionless")
     keys = [k for k in rows[0] if k not in ("travel", "Fz", "Fx", "iterations")]
     demo.table("sliding_sphere_3d.csv", [{k: r[k] for k in keys} for r in rows])
     demo.table("history.csv", [{"travel": t, "Fz_flat": a, "Fx_flat": b, "Fz_smooth": c, "Fx_smooth": d}

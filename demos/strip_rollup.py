@@ -92,14 +92,26 @@ def strip_scene(demo):
 
 # %% [markdown]
 # ## Thirty load steps to the full circle
+#
+# `strip_shapes.png` draws the strip at $M$ = 0.27, 0.5, 0.77 and 1 × $2\pi EI/L$ over its
+# flat outline, coloured by the angle of the nodal rotations (between 0 and π, so the tip of the
+# closed circle is back at 0).
 
 # %%
 def full_circle(demo, scene):
     """The run (fields in strip.xdmf) and the tip error / L at every step."""
+    shots = dc.plot.Snapshots(scene, at=(0.25, 0.5, 0.75, 1.0))  # for the PyVista picture
     with dc.io.FieldWriter(scene, demo.path("strip.xdmf")) as writer:
-        result, wall = timed(dc.solve, scene, dc.LoadControl(steps=30), on_step=writer)
+        def on_step(row):
+            writer(row)
+            shots(row)
+
+        result, wall = timed(dc.solve, scene, dc.LoadControl(steps=30), on_step=on_step)
     hist = result.history
     demo.write_result(result)
+    demo.picture(shots, "strip_shapes.png", field="rotation", layout="overlay", window_size=(1100, 800),
+                 camera=[(6.0, -40.0, 12.0), (6.0, 0.5, 2.0), (0.0, 0.0, 1.0)],
+                 title="Strip roll-up: M = 0.27, 0.5, 0.77, 1 × 2πEI/L")
     lam = hist.column("load_factor")
     u, w = hist.column("tip_ux_mean"), hist.column("tip_uz_mean")
     u_ex, w_ex = tip_closed_form(lam)

@@ -45,7 +45,7 @@ import numpy as np
 
 import dolfinx_corot as dc
 from dolfinx_corot.gallery import Demo
-from frame_filling_1 import build, draw_stages, run, verify_common
+from frame_filling_1 import build, draw_stages, picture_stages, run, verify_common
 
 GEOMETRY = dict(width=18.0, height=12.0, pit_width=12.0, pit_depth=6.0, span=6.0, rise=3.5, thickness=0.3)
 GROUND = dict(E=5e6, nu=0.3, rho=2000.0)
@@ -53,12 +53,15 @@ FILL = dict(E=3e6, nu=0.3, rho=1800.0)
 LINING = dict(E=5e9, nu=0.2, rho=2500.0)
 
 
-def tunnel(demo, approach: str) -> tuple:
+def tunnel(demo, approach: str, shots: bool = False) -> tuple:
+    """(setup, run's output, the error that stopped it or None); ``shots``: the state at the end of
+    every stage kept for a PyVista picture (``out["shots"]``)."""
     setup = build("fill", geometry=GEOMETRY, ground=GROUND, fill_material=FILL, frame_material=LINING,
                   layers=(3, 4), size=0.5)
     snapshots = {}
+    kept = dc.plot.Snapshots(setup["scene"]) if shots else None
     try:
-        return setup, run(demo, setup, approach, snapshots), None
+        return setup, dict(run(demo, setup, approach, snapshots, shots=kept), shots=kept), None
     except dc.ConvergenceError as err:
         demo.say(f"approach {approach} stopped in stage {len(err.results) - 1}: {str(err)[:160]}…")
         return setup, dict(snapshots=snapshots), err
@@ -73,6 +76,10 @@ def heave(snapshot, x, y) -> float:
 
 # %% [markdown]
 # ## Output
+#
+# `tunnel_stages.png` pictures approach II at the end of each stage after the geostatic one:
+# the pit's floor heaving by 11 cm, then the lining and the ground settling as the seven layers
+# are placed (displacements × 5, coloured by their magnitude; the undeformed shape in grey).
 
 # %%
 def plot(demo, out, setup, stopped) -> None:
@@ -111,10 +118,12 @@ def plot(demo, out, setup, stopped) -> None:
 # %%
 def main() -> dict:
     demo = Demo("tunnel_construction")
-    setup, out, _ = tunnel(demo, "II")
+    setup, out, _ = tunnel(demo, "II", shots=True)
     setup_i, out_i, err = tunnel(demo, "I")
     demo.table("stages.csv", out["rows"])
     draw_stages(demo, out, scale=5.0)
+    picture_stages(demo, out["shots"], "tunnel_stages.png", "II", scale=5.0, names={"frame": "lining"}, columns=3,
+                   window_size=(1800, 1500))
     g = GEOMETRY
     y_floor = g["height"] - g["pit_depth"]
     lifted = heave(out["snapshots"]["excavation"], 0.0, y_floor)

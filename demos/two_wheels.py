@@ -140,7 +140,8 @@ def wheels_scene(demo, h=0.06):
 # ## Load path: 32 steps (λ = 0.05) down and back up
 # After every step: the contact force of each interface pair (sum of the
 # nodal pressures times their tributary lengths) and the rims' shapes at
-# four stages for the snapshots.
+# four stages for the snapshots. `two_wheels_stages.png` draws the three
+# bodies at those four stages over their initial outlines, coloured by $|u|$.
 
 # %%
 def contact_force(pair):
@@ -165,6 +166,11 @@ def drive(demo, sc, interfaces):
     snapshots (load factor, rims) of the four stages."""
     records = []
     snapshots = {}
+    shots = dc.plot.Snapshots(sc)  # the PyVista states of the four stages
+
+    def keep(stage, lam):
+        snapshots[stage] = (lam, rims(interfaces))
+        shots.take(f"{stage} (λ = {lam:.2f}, hubs {path(lam):+.2f})", lam)
 
     def on_step(row):
         lam = row["load_factor"]
@@ -174,14 +180,14 @@ def drive(demo, sc, interfaces):
         records.append(rec)
         touching = rec["wheel-wheel"] > 0
         if touching and snapshots.get("first contact") is None:
-            snapshots["first contact"] = (lam, rims(interfaces))
+            keep("first contact", lam)
         if abs(lam - 1.0) < 1e-9:
-            snapshots["advanced contact"] = (lam, rims(interfaces))
+            keep("advanced contact", lam)
         if (not touching and lam > 1.0 and snapshots.get("first contact")
                 and not snapshots.get("separation from each other")):
-            snapshots["separation from each other"] = (lam, rims(interfaces))
+            keep("separation from each other", lam)
         if abs(lam - 1.6) < 1e-9:
-            snapshots["lifted off the foundation"] = (lam, rims(interfaces))
+            keep("lifted off the foundation", lam)
 
     res = dc.solve(sc, dc.LoadControl(steps=32 if demo.ci else 48, final=1.6), on_step=on_step)
     hist = res.history
@@ -191,6 +197,8 @@ def drive(demo, sc, interfaces):
     for name, snap in snapshots.items():
         if snap:
             demo.say(f"  {name}: λ = {snap[0]:.2f}, hubs at u_y = {path(snap[0]):+.3f}")
+    demo.picture(shots, "two_wheels_stages.png", field="displacement", layout="grid", columns=2,
+                 window_size=(1400, 900))
     return hist, records, snapshots
 
 

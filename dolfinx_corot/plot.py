@@ -134,23 +134,6 @@ def grid_of(part: dict, field: str = "displacement", deformed: bool = True, scal
     return _grid(_pyvista(), part, deformed, scale, field)
 
 
-def _font() -> str | None:
-    """A font with Greek letters (DejaVu Sans, found by matplotlib), or None: VTK's own."""
-    try:
-        from matplotlib import font_manager
-
-        return font_manager.findfont("DejaVu Sans", fallback_to_default=False)
-    except (ImportError, ValueError):
-        return None
-
-
-def _use_font(prop, font: str | None) -> None:
-    """Set a VTK text property to the font file ``font``."""
-    if font:
-        prop.SetFontFamily(4)  # VTK_FONT_FILE
-        prop.SetFontFile(font)
-
-
 def _grid(pv, part: dict, deformed: bool, scale: float, field: str):
     """The PyVista dataset of one part (existing cells only) and its point field (or None)."""
     keep = np.asarray(part["exists"], dtype=bool)
@@ -187,7 +170,7 @@ def _shape(pv, grid, cell: str, gdim: int, length: float, outline: bool):
         if gdim == 3 and not outline and grid.n_cells:
             size = grid.cell_data.get("size")
             radius = float(np.median(size)) if size is not None and np.any(size > 0) else 0.0
-            radius = min(max(radius, 2e-3 * length), 0.02 * length)
+            radius = min(max(radius, 3e-3 * length), 0.02 * length)
             return lines.tube(radius=radius, n_sides=12), {}
         return lines, {"line_width": 1.5 if outline else 4.0}
     surface = grid.extract_surface(algorithm=None)
@@ -201,7 +184,7 @@ def _shape(pv, grid, cell: str, gdim: int, length: float, outline: bool):
 def picture(states, filename: str, *, field: str = "displacement", scale: float = 1.0,
             layout: str = "auto", title: str | None = None, undeformed: bool = True,
             window_size: tuple = (1400, 800), camera: str | None = None, show_edges: bool | None = None,
-            columns: int = 3, clim: tuple | None = None) -> str | None:
+            columns: int = 3, clim: tuple | None = None, zoom: float = 1.0) -> str | None:
     """Draw ``states`` (a :class:`State`, a list of them, or a scene: its current state) into the
     PNG ``filename``; returns the path on rank 0, None on the others (collective when given a
     scene, which is captured first).
@@ -212,7 +195,9 @@ def picture(states, filename: str, *, field: str = "displacement", scale: float 
     shape in grey (a thin outline of surfaces and solids); camera: 'xy' (2D scenes' default),
     'iso' (3D default) or a PyVista camera position; show_edges: the cells' edges on surfaces
     (default: with fewer than 5000 cells); clim: the colour range (default: from 0 to the
-    largest value over the states).
+    largest value over the states); zoom: the camera's magnification after every state has been
+    fitted into the view (> 1 for shallow structures that fill a thin band). Every view of a grid
+    shows the same region: the bounds of all states.
     """
     if field not in FIELDS:
         raise ValueError(f"picture: field '{field}' is not one of {list(FIELDS)}")
@@ -243,17 +228,15 @@ def picture(states, filename: str, *, field: str = "displacement", scale: float 
         clim = (0.0, top if top > 0.0 else 1.0)
     ncells = sum(len(p["X"]) for p in states[0].parts)
     edges = (ncells < 5000) if show_edges is None else show_edges
-    plotter = pv.Plotter(off_screen=True, shape=(nrows, ncols), window_size=window_size, border=False)
     colours = ["#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860"]
-    bar = None if field == "none" else dict(
-        title=FIELDS[field] + (f" (×{scale:g})" if scale != 1.0 and field == "displacement" else ""), n_labels=4,
-        fmt="%.3g", color="black", vertical=True, position_x=0.88 if ncols == 1 else 0.8, position_y=0.2,
-        width=0.06 if ncols == 1 else 0.15, height=0.6, title_font_size=18, label_font_size=14)
-    font = _font()
+    bounds = [float(v) for pair in zip(np.r_[corners.min(axis=0), [0.0] * (3 - gdim)],
+                                        np.r_[corners.max(axis=0), [0.0] * (3 - gdim)]) for v in pair]
     index = {id(s): i for i, s in enumerate(states)}
-    mapper = None
-    for k, view in enumerate(views):
-        plotter.subplot(k // ncols, k % ncols)
+    size = (max(int(window_size[0] / ncols), 200), max(int(window_size[1] / nrows), 150))
+    images = []
+    for view in views:  # VTK draws the shapes, one view at a time, all fitted to the same bounds
+        plotter = pv.Plotter(off_screen=True, window_size=size, border=False)
+        plotter.set_background("white")
         for s in view:
             for j, (grid, part) in enumerate(grids[index[id(s)]]):
                 if not grid.n_cells:
@@ -271,14 +254,7 @@ def picture(states, filename: str, *, field: str = "displacement", scale: float 
                 if part["cell"] not in LINE_CELLS:
                     kwargs.update(show_edges=edges, edge_color="#303030", line_width=0.5 if edges else None)
                     kwargs = {k_: v for k_, v in kwargs.items() if v is not None}
-                actor = plotter.add_mesh(shape, smooth_shading=False, **kwargs)
-                if mapper is None and field != "none":
-                    mapper = actor.mapper
-        heading = view[0].label if len(view) == 1 else (title or ", ".join(s.label for s in view))
-        if len(view) == 1 and title and k == 0:
-            heading = f"{title}\n{heading}" if heading else title
-        if heading:
-            plotter.add_text(heading, position="upper_left", font_size=12, color="black", font_file=font)
+                plotter.add_mesh(shape, smooth_shading=False, **kwargs)
         if gdim == 2 or camera == "xy":
             plotter.view_xy()
             plotter.enable_parallel_projection()
@@ -286,17 +262,39 @@ def picture(states, filename: str, *, field: str = "displacement", scale: float 
             plotter.view_isometric()
         else:
             plotter.camera_position = camera
-        plotter.reset_camera()
-    if mapper is not None:  # in the last view, at its right
-        plotter.subplot((len(views) - 1) // ncols, (len(views) - 1) % ncols)
-        scalar_bar = plotter.add_scalar_bar(mapper=mapper, **bar)
-        _use_font(scalar_bar.GetTitleTextProperty(), font)
-        _use_font(scalar_bar.GetLabelTextProperty(), font)
-    if nrows * ncols > 1:
-        plotter.link_views()
-    plotter.set_background("white")
+        plotter.reset_camera(bounds=bounds)
+        if zoom != 1.0:
+            plotter.camera.zoom(zoom)
+        images.append(plotter.screenshot(return_img=True))
+        plotter.close()
+    # matplotlib lays the views out with their headings and one colour bar (VTK draws no text)
+    from matplotlib import cm, colors
+    from matplotlib.figure import Figure
+
+    dpi = 100
+    bar_width = 0.9 if field != "none" else 0.0
+    fig = Figure(figsize=(ncols * size[0] / dpi + bar_width, nrows * size[1] / dpi + 0.6), dpi=dpi)
+    grid_spec = fig.add_gridspec(nrows, ncols + (1 if bar_width else 0),
+                                 width_ratios=[size[0] / dpi] * ncols + ([0.12] if bar_width else []),
+                                 left=0.01, right=0.93 if bar_width else 0.99, top=0.9, bottom=0.02, wspace=0.02,
+                                 hspace=0.12)
+    for k, (view, image) in enumerate(zip(views, images)):
+        ax = fig.add_subplot(grid_spec[k // ncols, k % ncols])
+        ax.imshow(image)
+        ax.set_axis_off()
+        heading = view[0].label if len(view) == 1 else ", ".join(s.label for s in view if s.label)
+        if heading:
+            ax.set_title(heading, fontsize=11)
+    heading = title or ""
+    if scale != 1.0:
+        heading = f"{heading} (shapes ×{scale:g})" if heading else f"shapes ×{scale:g}"
+    if heading:
+        fig.suptitle(heading, fontsize=13)
+    if bar_width:
+        axis = fig.add_subplot(grid_spec[:, ncols])
+        mappable = cm.ScalarMappable(norm=colors.Normalize(*clim), cmap="viridis")
+        fig.colorbar(mappable, cax=axis, label=FIELDS[field])
     folder = os.path.dirname(os.path.abspath(filename))
     os.makedirs(folder, exist_ok=True)
-    plotter.screenshot(filename)
-    plotter.close()
+    fig.savefig(filename, dpi=dpi)
     return filename

@@ -77,6 +77,12 @@ def test_demo_runs_and_verifies(demo, serial_outputs, monkeypatch):
     assert report["values"].get("load_factor"), "no values recorded for the MPI comparison"
     files = os.listdir(serial_outputs / demo)
     assert any(f.endswith(".csv") for f in files) and any(f.endswith(".png") for f in files), files
+    # at least one PyVista picture of the deformed parts (Demo.picture), written and not blank
+    assert report["pictures"], f"{demo} draws no PyVista picture"
+    from matplotlib.image import imread
+    for picture in report["pictures"]:
+        rgb = imread(serial_outputs / demo / picture)[:, :, :3]
+        assert np.mean(rgb.max(axis=2) - rgb.min(axis=2) > 0.1) > 0.002, f"{picture} has almost nothing in colour"
     assert json.loads((serial_outputs / demo / "tip_values.json").read_text())["ranks"] == 1
     plt = sys.modules.get("matplotlib.pyplot")
     assert plt is None or not plt.get_fignums(), f"{demo} left pyplot figures open"

@@ -453,7 +453,7 @@ class Part:
         """For drawing: (X (cells, vertices, gdim) the initial positions of the vertices of every
         owned cell, u (cells, vertices, gdim) their displacement, exists (cells,) whether the cell
         has an existing element), on every rank, rank by rank. Quadrilateral vertices in the
-        order of their outline."""
+        order of their outline (hexahedra: each face's)."""
         X, u, exists, _ = self._owned_cell_drawing()
         gather = (lambda a: np.concatenate(self.comm.allgather(a)))
         return gather(X), gather(u), gather(exists)
@@ -469,6 +469,8 @@ class Part:
         blocks = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)[:n_owned, :nv]
         if mesh.topology.cell_type == dolfinx.mesh.CellType.quadrilateral:
             blocks = blocks[:, [0, 1, 3, 2]]
+        elif mesh.topology.cell_type == dolfinx.mesh.CellType.hexahedron:  # VTK's order: each face's outline
+            blocks = blocks[:, [0, 1, 3, 2, 4, 5, 7, 6]]
         X = self.V.tabulate_dof_coordinates()[:, : self.gdim][blocks]
         u = self.state.x.array.reshape(-1, self.state_size)[:, : self.gdim][blocks]
         exists = (self.cells_existing() if self.is_staged() else self._cells_active())[:n_owned]

@@ -47,8 +47,8 @@ L, H, B = p["L"], p["H"], p["B_3D"]
 # ## Displacement-driven compression through the bifurcation
 # As in 2D: the first 0.04 m of push in steps of 0.5 mm (the column buckles
 # near 0.02 m), then steps of 40 mm to 1 m. MUMPS LDLᵀ solves the Newton
-# systems. `euler_continuum_3d_shapes.png` draws the 10 × 2 × 2 column pushed by 1, 0.6, 0.4
-# and 0.2 m (from the last state back) over its initial outline, coloured by $|u|$.
+# systems. `euler_continuum_3d_shapes.png` draws the 10 × 2 × 2 column pushed by 0.2, 0.4, 0.6
+# and 1 m over its initial outline, coloured by $|u|$.
 
 # %%
 def column(nx: int, ny: int):
@@ -72,7 +72,7 @@ def meshes(demo):
         if (nx, ny) == (10, 2):  # the mesh of every run: its picture
             picture = (demo, "euler_continuum_3d_shapes.png",
                        dict(field="displacement", layout="grid", columns=2, window_size=(1400, 900),
-                            title=f"H27 {nx} x {ny} x {ny}: push 1, 0.6, 0.4, 0.2 m"))
+                            title=f"H27 {nx} x {ny} x {ny}: push 0.2, 0.4, 0.6, 1 m"))
         scene, res, wall = compress(column(nx, ny), 2, "x0", picture)
         Pcr, npts = critical_load(res)
         h = res.history

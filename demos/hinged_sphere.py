@@ -67,9 +67,9 @@ def sphere(n, steps=40, demo=None):
     shots = dc.plot.Snapshots(scene, at=(0.2, 0.4, 0.6, 1.0)) if demo is not None else None
     res, wall = timed(dc.solve, scene, dc.LoadControl(steps=steps), on_step=shots)
     if demo is not None:  # the last state first (the views share the first one's camera), seen from −y
-        demo.picture(shots.states[::-1], "cap_shapes.png", field="displacement", layout="grid", columns=2,
+        demo.picture(shots.states, "cap_shapes.png", field="displacement", layout="grid", columns=2,
                      window_size=(1300, 850), camera=[(20.0, -45.0, 12.0), (7.5, 7.5, 0.0), (0.0, 0.0, 1.0)],
-                     title=f"Hinged cap ({n} x {n} quarter), w = 2.5, 1.5, 1, 0.5 h")
+                     title=f"Hinged cap ({n} x {n} quarter)", zoom=1.6)
     w = np.r_[0.0, 2.5 * h * res.history.column("load_factor")]
     P = np.r_[0.0, -4.0 * res.history.column("centre_Fz")]  # the whole cap: four quarters
     return w, P, res, wall
@@ -79,7 +79,7 @@ def sphere(n, steps=40, demo=None):
 # ## Three meshes
 #
 # `cap_shapes.png` draws the quarter cap of the finest mesh at central displacements of
-# 2.5, 1.5, 1 and 0.5 $h$ (from the last state back; the centre is the left corner), coloured by
+# 0.5, 1, 1.5 and 2.5 $h$ (the centre is the left corner), coloured by
 # $|u|$ over its initial outline: from the dent before the snap to the inverted cap.
 
 # %%

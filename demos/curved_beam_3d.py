@@ -105,6 +105,8 @@ def work_precision(demo, hist):
     study = np.array(study)
 
     demo.table("work_precision.csv", study, ["elements", "tip_rel_error", "wall_time_s", "newton_iterations"])
+    demo.work_precision(study[:, 0].astype(int), study[:, 1], study[:, 2], reference=B2C,
+                        quantity="tip displacement (elements)")
     fig, ax = demo.figure(1, 2, figsize=(11, 4.2))
     lam = hist.column("load_factor")
     for k, (name, c) in enumerate((("$u_x$", "tip_ux"), ("$u_y$", "tip_uy"), ("$u_z$", "tip_uz"))):

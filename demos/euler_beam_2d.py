@@ -34,7 +34,7 @@ from dolfinx_corot.io import reference
 from dolfinx_corot.io.gmsh_models import polyline
 
 comm = MPI.COMM_WORLD
-here = os.path.dirname(os.path.abspath(__file__))
+here = os.path.dirname(os.path.abspath(__file__)) if "__file__" in globals() else os.getcwd()  # a notebook: demos/
 B1 = "B1 exact extensible Bernoulli elastica, e = 0.01 m (reference/B1_elastica_eccentric_compression.json)"
 
 # %% [markdown]
@@ -217,6 +217,8 @@ def work_precision(demo):
     order = np.log(study[-2, 1] / study[-1, 1]) / np.log(study[-1, 0] / study[-2, 0])
     demo.say(f"observed order of convergence between the two finest meshes: {order:.2f}")
     demo.table("work_precision.csv", study, ["elements", "max_rel_error", "wall_time_s", "newton_iterations"])
+    demo.work_precision(study[:, 0].astype(int), study[:, 1], study[:, 2], reference=B1,
+                        quantity="tip displacement (largest error along the path; elements)")
     fig, ax = demo.figure(figsize=(5, 4))
     ax.loglog(study[:, 2], study[:, 1], "o-")
     for n, err, dt, _ in study:

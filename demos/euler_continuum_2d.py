@@ -171,6 +171,8 @@ def work_precision(demo):
              "(observed orders", ", ".join(f"{np.log(c / b) / np.log(b / a):.2f}"
                                            for a, b, c in zip(residuals, residuals[1:], residuals[2:])) + ")")
     demo.table("work_precision.csv", rows)
+    demo.work_precision([r["dofs"] for r in rows], [r["error"] for r in rows], [r["wall_s"] for r in rows],
+                        reference=B4, quantity="critical load, plane strain (dofs)")
     return rows, curves, residuals
 
 

@@ -148,13 +148,15 @@ class Demo:
         """What accuracy costs: the relative ``error`` of ``quantity`` (against ``reference``) and the
         wall ``time`` of each run, mesh by mesh (``resolution``: elements, nodes or dofs), to
         ``<out>/work_precision.json`` on rank 0; the documentation gathers every demo's in one
-        plot (accuracy against time)."""
+        plot (accuracy against time). Runs whose error is not a number are left out."""
         if not (len(resolution) == len(error) == len(time)):
             raise ValueError("work_precision: resolution, error and time need one entry per run")
+        keep = [k for k, e in enumerate(error) if np.isfinite(float(e))]  # runs without a value are left out
         if self.rank == 0:
             with open(self.path("work_precision.json"), "w") as f:
-                json.dump({"quantity": quantity, "reference": reference, "resolution": _plain(list(resolution)),
-                           "error": [abs(float(e)) for e in error], "time": [float(t) for t in time]}, f,
+                json.dump({"quantity": quantity, "reference": reference,
+                           "resolution": [_plain(resolution[k]) for k in keep],
+                           "error": [abs(float(error[k])) for k in keep], "time": [float(time[k]) for k in keep]}, f,
                           indent=1)
 
     def table(self, filename: str, rows: Union[Sequence[dict], np.ndarray],

@@ -25,7 +25,7 @@ debs=(python3-dolfinx-real python3-gmsh python3-meshio python3-venv python3-h5py
       python3-pandas libegl1 libegl-mesa0 openmpi-bin)
 pip_pkgs=(numba pyvista tqdm pytest hypothesis)
 docs_debs=(python3-sphinx python3-myst-parser libjs-mathjax chromium chromium-driver python3-selenium)
-docs_pip=("furo==2022.12.7" jupytext nbclient ipykernel)
+docs_pip=("furo==2022.12.7" "markdown-it-py<3" jupytext nbclient ipykernel)  # myst-parser 0.18 needs markdown-it-py 2
 
 if [[ "${1:-}" == "docs" ]]; then
     bash "$0"  # the library first

@@ -33,6 +33,17 @@ GALLERY = DOCS / "gallery"
 OUTPUT = Path(os.environ.get("DC_OUTPUT_DIR", ROOT / "output"))
 
 
+def demo_names(only=None) -> list[str]:
+    """The demos (``demos/*.py`` stems), or those of ``only``; an unknown name stops with the list."""
+    names = sorted(p.stem for p in DEMOS.glob("*.py"))
+    if not only:
+        return names
+    unknown = sorted(set(only) - set(names))
+    if unknown:
+        raise SystemExit(f"no demo named {', '.join(unknown)}; the demos: {', '.join(names)}")
+    return [n for n in names if n in only]
+
+
 def cells(source: str) -> list[tuple[str, str]]:
     """(kind, text) of the percent-format cells of a demo: 'markdown' (comment marks removed) or
     'code'; the jupytext header is dropped."""
@@ -149,7 +160,8 @@ def gallery_index(entries: list[dict]) -> None:
     for e in entries:
         lines += [f"## [{e['title']}]({e['name']}.md)", ""]
         if e["picture"]:
-            lines += ["```{image} " + f"{e['name']}/{e['picture']}", f":alt: {e['title'].replace(':', ' -')}", ":width: 420px", "```", ""]
+            alt = e["title"].replace(":", " -")  # a colon would start a directive option
+            lines += ["```{image} " + f"{e['name']}/{e['picture']}", f":alt: {alt}", ":width: 420px", "```", ""]
         lines += [f"`demos/{e['name']}.py` · {e['checks']} verified numbers", ""]
     (GALLERY / "index.md").write_text("\n".join(lines) + "\n")
 
@@ -254,9 +266,7 @@ def main() -> None:
     parser.add_argument("--run", action="store_true", help="run every demo again (shortened form)")
     parser.add_argument("--only", nargs="*", help="these demos only")
     args = parser.parse_args()
-    names = sorted(p.stem for p in DEMOS.glob("*.py"))
-    if args.only:
-        names = [n for n in names if n in args.only]
+    names = demo_names(args.only)
     GALLERY.mkdir(parents=True, exist_ok=True)
     copy_mathjax()
     for name in names:

@@ -16,6 +16,8 @@ import sys
 import time
 from pathlib import Path
 
+from docs import demo_names  # noqa: E402  (scripts/ is the script's folder)
+
 ROOT = Path(__file__).resolve().parents[1]
 DEMOS = ROOT / "demos"
 OUT = Path(os.environ.get("DC_OUTPUT_DIR", ROOT / "output")) / "notebooks"
@@ -31,9 +33,7 @@ def main() -> int:
     parser.add_argument("--only", nargs="*", help="these demos only")
     parser.add_argument("--no-run", action="store_true", help="convert only")
     args = parser.parse_args()
-    names = sorted(p.stem for p in DEMOS.glob("*.py"))
-    if args.only:
-        names = [n for n in names if n in args.only]
+    names = demo_names(args.only)
     OUT.mkdir(parents=True, exist_ok=True)
     os.environ.update(CI="true", DC_OUTPUT_DIR=str(OUT / "outputs"), DC_PROGRESS="off")
     failed = []

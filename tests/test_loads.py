@@ -263,3 +263,13 @@ def test_unsupported_follower_loads_are_refused_with_the_reason():
         sc2.load(beam2, "tip", force=(0.0, 1.0), follower=True)
     with pytest.raises(ValueError, match="group 'tip' has dimension 0; a group of cells"):
         sc2.load(beam2, "tip", per_length=(0.0, 1.0))
+    # a load per length on a shell, a pressure on a solid without a facet group
+    sc3 = dc.Scene()
+    plate = sc3.add_shell(_octant(2), "skin", thickness=0.01, material=dc.Elastic(1e3, 0.3))
+    with pytest.raises(ValueError, match="load per length on shell 'skin': it acts on beams and bars"):
+        sc3.load(plate, None, per_length=(0.0, 0.0, 1.0))
+    tm4 = rectangles({"block": (0.0, 0.0, 1.0, 1.0, 2, 2)}, {"right": [("block", "right")]}, comm=comm)
+    sc4 = dc.Scene()
+    block = sc4.add_solid(tm4, material=dc.NeoHookean(1.0, 0.3), degree=1)
+    with pytest.raises(ValueError, match=r"pressure on a solid: name the group of facets it acts on \(where=...\)"):
+        sc4.pressure(block, None, 1.0)

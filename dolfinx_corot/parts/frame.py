@@ -66,7 +66,9 @@ class LineFrame(Part):
         self._owner_of_cell = np.full(cmap.size_local + cmap.num_ghosts, "", dtype=object)
         self._bending = np.zeros(cmap.size_local + cmap.num_ghosts, dtype=bool)
         self._element_props: list[tuple[str, list[float]]] = []
-        self._gravity: list[tuple[str, str | None, np.ndarray, object, Condition]] = []
+        # uniform dead loads on elements: (label, where, q or q(cells, X), amplitude, condition) — weights,
+        # loads per length, dead pressures
+        self._distributed: list[tuple[str, str | None, object, object, Condition]] = []
         self.followers: list[FollowerLoad] = []
         self._init_conditions()
 
@@ -171,7 +173,7 @@ class LineFrame(Part):
             raise ValueError(f"gravity on {label}: group '{where}' holds none of its elements")
         q = float(density) * measure * np.asarray(acceleration, dtype=float)
         condition = condition or Condition("gravity", f"on {label}")
-        self._gravity.append((label, where, q, amplitude, condition))
+        self._distributed.append((label, where, q, amplitude, condition))
         return condition
 
     def _loaded_cells(self, part: PartRef, where: str | None, what: str) -> np.ndarray:
@@ -202,13 +204,13 @@ class LineFrame(Part):
                                                condition))
             return condition
         if axes == "global":
-            self._gravity.append((label, where, q, amplitude, condition))
+            self._distributed.append((label, where, q, amplitude, condition))
             return condition
 
         def in_element_axes(cells, X, q=q):
             axes = self._initial_axes(cells, X)
             return np.einsum("i,nij->nj", q, axes[:, : len(q)])
-        self._gravity.append((label, where, in_element_axes, amplitude, condition))
+        self._distributed.append((label, where, in_element_axes, amplitude, condition))
         return condition
 
     def _initial_axes(self, cells: np.ndarray, X: np.ndarray) -> np.ndarray:
@@ -224,13 +226,14 @@ class LineFrame(Part):
                          "faces of solids); on beams and bars give a load per length (scene.load(..., per_length=))")
 
     def load_conditions(self) -> list:
-        return [(amp, cond) for *_, amp, cond in self._point_loads + self._gravity] + \
+        return [(amp, cond) for *_, amp, cond in self._point_loads + self._distributed] + \
             [(f.amplitude, f.condition) for f in self.followers]
 
     def _add_distributed_loads(self, b: PETSc.Vec, amplitude) -> None:
-        """Add the self-weight loads of one amplitude (None: proportional to λ) at unit factor,
-        from the reference positions of the nodes."""
-        terms = [(label, where, q) for label, where, q, amp, cond in self._gravity if amp is amplitude and cond.exists]
+        """Add the uniform dead loads (weights, loads per length, dead pressures) of one amplitude (None:
+        proportional to λ) at unit factor, from the reference positions of the nodes."""
+        terms = [(label, where, q) for label, where, q, amp, cond in self._distributed
+                 if amp is amplitude and cond.exists]
         if not terms:
             return
         g = self.gdim

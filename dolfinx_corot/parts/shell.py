@@ -95,7 +95,7 @@ class Surface3D(Rotations3D, LineFrame):
             else:  # the normal at the centre of the bilinear patch (nodes (0,0), (1,0), (0,1), (1,1))
                 n = np.cross(X[:, 1] + X[:, 3] - X[:, 0] - X[:, 2], X[:, 2] + X[:, 3] - X[:, 0] - X[:, 1])
             return p * n / np.linalg.norm(n, axis=1)[:, None]
-        self._gravity.append((label, where, along_initial_normals, amplitude, condition))
+        self._distributed.append((label, where, along_initial_normals, amplitude, condition))
         return condition
 
     def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray:

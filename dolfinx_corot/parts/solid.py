@@ -175,7 +175,9 @@ class Solid(AdditiveState, Part):
         """A uniform pressure p on the facets of group ``where``, along their inward normal: dead (p N₀ per
         unit reference area) or following (p n per unit current area: p J F⁻ᵀN, Nanson's formula), see
         ``Scene.pressure``."""
-        if where is None or self.tmesh.facets(where) is None:
+        if where is None:
+            raise ValueError("pressure on a solid: name the group of facets it acts on (where=...)")
+        if self.tmesh.facets(where) is None:
             raise ValueError(f"pressure on '{where}': a group of facets (dimension {self.tdim - 1}) read with "
                              "from_gmsh is needed")
         condition = condition or Condition("load", f"pressure on '{where}'")

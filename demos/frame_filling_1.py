@@ -160,7 +160,8 @@ def run(demo, setup, approach: str, snapshots: dict | None = None, shots=None) -
         snapshots[stage.name] = dict(soil=setup["soil"].model.cell_shapes(),
                                      frame=setup["frame"].model.cell_shapes(),
                                      slab=setup["slab"].model.cell_shapes(),
-                                     stress=_vertical_stress(setup["soil"].model), **frame_state(setup))
+                                     stress=_vertical_stress(setup["soil"].model),
+                                     sections=setup["scene"].element_results(setup["frame"]), **frame_state(setup))
 
     results, wall = timed(solve_stages, setup["scene"], setup["stages"], approach=approach,
                           initial=setup["initial"], on_step=keep)
@@ -230,6 +231,25 @@ def picture_stages(demo, shots, filename: str, approach: str, scale: float, name
     demo.picture(states, filename, scale=scale, title=f"approach {approach}", **options)
 
 
+def draw_moments(demo, out, filename: str, stages=None) -> None:
+    """The frame's bending moments (walls and roof; per metre of the box) at the end of some
+    stages (default: the frame's stage, the middle and the last layer), drawn on the side of the
+    fibres in tension on the deformed frame (true scale), one scale for all panels."""
+    names = [n for n, snap in out["snapshots"].items() if len(snap["sections"])]
+    if stages is None:
+        stages = [names[0], names[len(names) // 2], names[-1]] if len(names) > 2 else names
+    sections = [out["snapshots"][n]["sections"] for n in stages]
+    largest = max(np.abs(r["M"]).max() for r in sections)
+    extent = float(np.ptp(sections[0].points.reshape(-1, 2), axis=0).max())
+    fig, axes = demo.figure(1, len(stages), figsize=(4.2 * len(stages), 4.0), squeeze=False)
+    for ax, name, r in zip(axes[0], stages, sections):
+        dc.plot.diagram(ax, r, "M", scale=0.25 * extent / largest, unit="Nm/m")
+        ax.set(title=f"after '{name}'", xlabel="x (m)", ylabel="y (m)")
+    fig.suptitle(f"approach {out['approach']}: bending moment in the frame, drawn on the side in tension",
+                 fontsize=9)
+    demo.save(fig, filename)
+
+
 def plot(demo, out, setup) -> None:
     rows = out["rows"]
     fig, ax = demo.figure(1, 2, figsize=(11.0, 4.0))
@@ -275,6 +295,7 @@ def main() -> dict:
     demo.table("stages.csv", out["rows"])
     draw_stages(demo, out, scale=50.0)
     picture_stages(demo, shots, "frame_filling_1_stages.png", "I", scale=50.0, columns=3, window_size=(1800, 1250))
+    draw_moments(demo, out, "frame_filling_1_moments.png")
     plot(demo, out, setup)
     rows = out["rows"]
     verify_common(demo, out, setup)

@@ -29,22 +29,39 @@ def cantilever_uniform_load(k: float, points: int = 2001) -> dict:
 
     Returns, in units of L, {"x_tip", "y_tip" (negative: along the load), "theta_tip" (the tip
     rotation, negative), "s", "x", "y", "moment" (EI θ'/(qL²) along s)}."""
+    return _cantilever_elastica(k, lambda t: 1.0 - t, points, "cantilever_uniform_load")
+
+
+def cantilever_tip_load(k: float, points: int = 2001) -> dict:
+    """The inextensible Bernoulli cantilever (clamped at s = 0, length L) under a dead tip force P
+    in −y, transverse to its straight axis along x, at k = PL²/EI: the elastica EI θ'' = P cos θ,
+    θ(0) = 0, θ'(L) = 0 (EI θ'(s) = P (x_tip − x(s)), the moment at s of the tip force), by
+    collocation as :func:`cantilever_uniform_load`. At k = 1 and 2 it gives the tip displacements
+    of Mattiasson (1981, Table 1): (L − x_tip, −y_tip)/L = (0.05643, 0.30172) and (0.16064, 0.49346),
+    tip rotations 0.46135 and 0.78175.
+
+    Returns, in units of L, {"x_tip", "y_tip", "theta_tip", "s", "x", "y", "moment" (EI θ'/(PL))}."""
+    return _cantilever_elastica(k, lambda t: np.ones_like(t), points, "cantilever_tip_load")
+
+
+def _cantilever_elastica(k: float, load, points: int, name: str) -> dict:
+    """EI θ'' = k load(s) cos θ on the unit cantilever (see :func:`cantilever_uniform_load`)."""
     from scipy.integrate import solve_bvp
 
     s = np.linspace(0.0, 1.0, points)
 
     def rhs(t, z):  # z = (θ, θ', x, y), lengths in L, θ toward the load
-        return np.vstack([z[1], k * (1.0 - t) * np.cos(z[0]), np.cos(z[0]), np.sin(z[0])])
+        return np.vstack([z[1], k * load(t) * np.cos(z[0]), np.cos(z[0]), np.sin(z[0])])
 
     def bc(a, b):
         return np.array([a[0], b[1], a[2], a[3]])
 
     guess = np.zeros((4, points))
-    guess[0] = -k * (s - s**2 + s**3 / 3) / 2  # the small-deflection slope
+    guess[0] = -k * (s - s**2 / 2) / 2  # of the order of the small-deflection slope
     guess[2] = s
     sol = solve_bvp(rhs, bc, s, guess, tol=1e-10, max_nodes=200000)
     if not sol.success:
-        raise RuntimeError(f"cantilever_uniform_load(k = {k}): the collocation did not converge ({sol.message})")
+        raise RuntimeError(f"{name}(k = {k}): the collocation did not converge ({sol.message})")
     theta, dtheta, x, y = sol.sol(s)
     return {"x_tip": float(x[-1]), "y_tip": float(y[-1]), "theta_tip": float(theta[-1]), "s": s, "x": x, "y": y,
             "moment": dtheta / k}

@@ -19,6 +19,12 @@ the nodal rotations, zero for parts without them), or ``"none"`` (one colour per
 undeformed shape is drawn in grey, the camera looks along z for 2D scenes and isometrically in
 3D, and the colour range is shared by every state of a picture.
 
+Section-force diagrams of frames, the way structural engineers read a lining or a beam, are
+drawn by matplotlib from element results::
+
+    fig, ax = matplotlib.pyplot.subplots()
+    dc.plot.diagram(ax, scene.element_results(lining), "M")   # moments on the tension side
+
 Capturing is collective (every rank calls it: the cells are gathered on rank 0); drawing
 happens on rank 0 only. PyVista renders without a display through EGL (Debian's libegl1
 and libegl-mesa0, installed by the set-up).
@@ -32,7 +38,7 @@ from typing import Sequence
 import numpy as np
 from mpi4py import MPI
 
-__all__ = ["Snapshots", "State", "capture", "grid_of", "picture"]
+__all__ = ["Snapshots", "State", "capture", "diagram", "grid_of", "picture"]
 
 FIELDS = {"displacement": "displacement", "rotation": "rotation (rad)", "none": None}
 LINE_CELLS = ("interval",)
@@ -298,3 +304,84 @@ def picture(states, filename: str, *, field: str = "displacement", scale: float 
     os.makedirs(folder, exist_ok=True)
     fig.savefig(filename, dpi=dpi)
     return filename
+
+
+# -- section-force diagrams ------------------------------------------------------------------------
+def _diagram_axis(results, component: str) -> tuple[int, float]:
+    """(row of ``results.axes`` along which ``component`` is drawn, sign): moments on the side of
+    the fibres they put in tension (2D M > 0 and 3D Mz > 0: the −e2 fibres; My > 0: the +e3
+    fibres), forces along e2 (Vz along e3) with their sign."""
+    if component == "My" or component == "Vz":
+        return 2, 1.0
+    if component in ("M", "Mz"):
+        return 1, -1.0
+    return 1, 1.0
+
+
+def diagram(ax, results, component: str = "M", *, scale: float | None = None, plane: Sequence[int] | None = None,
+            colors: tuple[str, str] = ("tab:blue", "tab:red"), annotate: bool = True, unit: str = ""):
+    """Draw the diagram of one section force of beams and bars along their current axis on the
+    matplotlib axes ``ax``: each element's values at its two ends, offset normal to the element —
+    moments on the side of the fibres in tension (the structural engineer's convention), normal
+    and shear forces with their sign — filled in ``colors`` (positive, negative), the extreme
+    value written at its place.
+
+    results: an :class:`~dolfinx_corot.result.ElementResults` of 'section forces' (or several, drawn
+    to one scale); component: one of its components (2D: N, V, M; 3D: N, Vy, Vz, T, My, Mz);
+    scale: length per unit of the component (default: the largest value drawn at a tenth of the
+    frame's extent); plane: the two coordinates drawn for 3D frames (default: the two of largest
+    extent). Returns ``ax``."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.patches import Polygon
+
+    many = list(results) if isinstance(results, (list, tuple)) else [results]
+    for r in many:
+        if r.kind != "section forces":
+            raise ValueError(f"diagram: {r!r} holds {r.kind}; diagrams are drawn for the section forces of beams")
+        if component not in r.components:
+            raise ValueError(f"diagram: section forces have no component '{component}'; they have {list(r.components)}")
+    points = np.concatenate([r.points.reshape(-1, r.points.shape[-1]) for r in many])
+    if len(points) == 0:
+        raise ValueError("diagram: no elements to draw")
+    gdim = points.shape[1]
+    if plane is None:
+        plane = (0, 1) if gdim == 2 else tuple(sorted(np.argsort(np.ptp(points, axis=0))[-2:]))
+    plane = list(plane)
+    extent = float(np.ptp(points[:, plane], axis=0).max()) or 1.0
+    largest = max(float(np.abs(r[component]).max(initial=0.0)) for r in many)
+    if scale is None:
+        scale = 0.1 * extent / largest if largest > 0 else 0.0
+    row, sign = _diagram_axis(many[0], component)
+    for r in many:
+        x = r.points[:, :, plane]                               # (n, 2, 2)
+        normal = r.axes[:, row][:, plane] if len(r) else np.zeros((0, 2))
+        length = np.linalg.norm(normal, axis=1)
+        normal = np.where(length[:, None] > 1e-12, normal / np.maximum(length, 1e-300)[:, None], 0.0)
+        v = r[component]                                        # (n, 2)
+        ax.add_collection(LineCollection(x, colors="k", linewidths=1.2, zorder=3))
+        for e in range(len(r)):
+            a, b = v[e]
+            pieces = [(0.0, 1.0)] if a * b >= 0 else [(0.0, a / (a - b)), (a / (a - b), 1.0)]
+            for t0, t1 in pieces:
+                ends = [x[e, 0] + t * (x[e, 1] - x[e, 0]) for t in (t0, t1)]
+                values = [a + t * (b - a) for t in (t0, t1)]
+                offset = [sign * scale * val * normal[e] for val in values]
+                corners = [ends[0], ends[1], ends[1] + offset[1], ends[0] + offset[0]]
+                positive = (values[0] + values[1]) >= 0.0
+                ax.add_patch(Polygon(corners, closed=True, facecolor=colors[0 if positive else 1], alpha=0.45,
+                                     edgecolor=colors[0 if positive else 1], linewidth=0.6, zorder=2))
+    if annotate and largest > 0:
+        for r in many:
+            v = r[component]
+            if len(r) and np.abs(v).max() == largest:
+                e, end = np.unravel_index(np.argmax(np.abs(v)), v.shape)
+                normal = r.axes[e, row][plane]
+                normal = normal / (np.linalg.norm(normal) or 1.0)
+                at = r.points[e, end][plane] + sign * scale * v[e, end] * normal
+                ax.annotate(f"{component} = {v[e, end]:.4g}{(' ' + unit) if unit else ''}", at, fontsize=8,
+                            xytext=(4, 4), textcoords="offset points", zorder=4)
+                break
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    ax.margins(0.08)
+    return ax

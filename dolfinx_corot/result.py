@@ -164,6 +164,93 @@ class Profile:
                    arrays[f"{prefix}values"], order)
 
 
+class ElementResults:
+    """Results element by element of one part at one state, in engineering terms, on every rank
+    (the same arrays in serial and under MPI, elements ordered by their input index).
+
+    kind: 'section forces' (beams and bars: the two ends of each element), 'shell resultants'
+    (shells and membranes: the centroid) or 'stresses' (solids: the centre of each cell);
+    components: the names of the values; cells: (n,) input index of each element; points:
+    (n, p, gdim) current positions where the values hold (p = 2 ends or 1 centre); values:
+    (n, p, len(components)); axes: (n, gdim, gdim) the element axes, rows e1, e2 (, e3), in the
+    current configuration (None for solids, whose components are global).
+
+    ``results["M"]`` is a component's (n, p) array; :meth:`extreme` its largest magnitude.
+    """
+
+    def __init__(self, kind: str, components, cells, points, values, axes=None, label: str = ""):
+        self.kind, self.components, self.label = kind, tuple(components), label
+        self.cells = np.asarray(cells, dtype=np.int64)
+        self.points = np.asarray(points, dtype=float)
+        self.values = np.asarray(values, dtype=float).reshape(len(self.cells), self.points.shape[1],
+                                                              len(self.components))
+        self.axes = None if axes is None else np.asarray(axes, dtype=float)
+
+    def __repr__(self) -> str:
+        return (f"ElementResults({self.kind} of {self.label or 'the part'}: {len(self.cells)} elements, "
+                f"components {', '.join(self.components)})")
+
+    def __len__(self) -> int:
+        return len(self.cells)
+
+    def __getitem__(self, component: str) -> np.ndarray:
+        """(n, p) values of one component."""
+        if component not in self.components:
+            raise KeyError(f"{self.kind} have no component '{component}'; they have {list(self.components)}")
+        return self.values[:, :, self.components.index(component)]
+
+    def reduce(self, how: str) -> dict[str, float]:
+        """One value per component over all elements and points: 'max', 'min', 'mean' or 'absmax'
+        (the value of largest magnitude, with its sign)."""
+        flat = self.values.reshape(-1, len(self.components))
+        if len(flat) == 0:
+            return {c: float("nan") for c in self.components}
+        if how == "absmax":
+            picked = flat[np.argmax(np.abs(flat), axis=0), np.arange(flat.shape[1])]
+        elif how in ("max", "min", "mean"):
+            picked = getattr(np, how)(flat, axis=0)
+        else:
+            raise ValueError(f"reduce = {how!r}: give 'max', 'min', 'mean' or 'absmax'")
+        return {c: float(v) for c, v in zip(self.components, picked)}
+
+    def extreme(self, component: str) -> float:
+        """The value of ``component`` of largest magnitude, with its sign."""
+        return self.reduce("absmax")[component]
+
+    def at(self, point, tolerance: float | None = None) -> dict[str, float]:
+        """The values at the element points nearest to ``point`` (current positions), averaged
+        over the elements meeting there (a beam's node: the ends of the elements on either side,
+        equal without a load on the node). tolerance: the largest distance accepted (default: a
+        thousandth of the extent of the points)."""
+        point = np.asarray(point, dtype=float)
+        flat = self.points.reshape(-1, self.points.shape[-1])
+        if len(flat) == 0:
+            raise ValueError(f"{self!r} holds no elements")
+        distance = np.linalg.norm(flat - point[: flat.shape[1]], axis=1)
+        extent = float(np.ptp(flat, axis=0).max()) or 1.0
+        tolerance = 1e-3 * extent if tolerance is None else tolerance
+        if distance.min() > tolerance:
+            raise ValueError(f"no element point of {self.label or 'the part'} within {tolerance:.3g} of "
+                             f"{point.tolist()} (the nearest is {distance.min():.3g} away)")
+        near = distance <= distance.min() + 1e-9 * extent
+        return {c: float(v) for c, v in zip(self.components,
+                                            self.values.reshape(-1, len(self.components))[near].mean(axis=0))}
+
+    def to_pandas(self):
+        """One row per element and point: cell, point index, x, y (, z), then the components."""
+        try:
+            import pandas
+        except ImportError:
+            raise ImportError("ElementResults.to_pandas needs pandas (Debian: apt install python3-pandas)") from None
+        n, p, _ = self.values.shape
+        data = {"cell": np.repeat(self.cells, p), "point": np.tile(np.arange(p), n)}
+        for k, axis in enumerate("xyz"[: self.points.shape[-1]]):
+            data[axis] = self.points[:, :, k].ravel()
+        for k, c in enumerate(self.components):
+            data[c] = self.values[:, :, k].ravel()
+        return pandas.DataFrame(data)
+
+
 def read_profiles(path: str) -> dict[str, Profile]:
     """The profiles of a ``<name>_profiles.npz`` file written by :meth:`Result.write`."""
     with np.load(path, allow_pickle=False) as data:

@@ -66,9 +66,10 @@ class Monitor:
     name: str
     part: PartRef
     where: str
-    kind: str = "dofs"  # or "reaction", or "contact" (part: a ContactPair, where: its side)
+    kind: str = "dofs"  # or "reaction", "contact" (part: a ContactPair, where: its side), "results"
     reduce: str | None = None
     along: object = None
+    components: tuple | None = None  # "results": the components recorded (None: all)
 
 
 class Scene:
@@ -497,6 +498,65 @@ class Scene:
                              "monitor a name of its own (its history columns carry it)")
         self.monitors.append(monitor)
 
+    def monitor_results(self, name: str, part: PartRef, where: str | None = None, reduce: str | None = None,
+                        components=None) -> None:
+        """Record element results (:meth:`element_results`) after every step.
+
+        where a node group of a beam part (one node): the section forces there, averaged over
+        the element ends that meet at the node (equal where no load acts on it), columns
+        ``name_N``, ``name_V``, ``name_M`` (3D: ``name_N`` … ``name_Mz``). where a cell group
+        (or None: all the part's elements) with reduce 'max', 'min', 'mean' or 'absmax': one
+        value per component over its elements, ``name_M_absmax``, ``name_mises_max``, …
+        components: the components to record (default: all of the part's, e.g. Nxx … mises_bottom
+        for shells, sxx … Exy for solids)."""
+        label = f"monitor_results '{name}'"
+        model = part.model
+        known = tuple(model.section_components) if hasattr(model, "section_components") else ()
+        if not known:
+            raise ValueError(f"{label}: {part.kind} parts have no element results")
+        chosen = known if components is None else tuple([components] if isinstance(components, str) else components)
+        unknown = [c for c in chosen if c not in known]
+        if unknown:
+            raise ValueError(f"{label}: {part.kind} results have no component(s) {unknown}; they have {list(known)}")
+        if where is not None and model.tmesh.groups.get(where, (None,))[0] != model.tmesh.tdim:
+            if model.tdim != 1:
+                raise ValueError(f"{label}: group '{where}' is not a group of the part's cells; results of "
+                                 f"{part.kind} parts are per cell: give a cell group and a reduction")
+            group = model.node_group(where)  # fails early for a missing group
+            if len(group) != 1 or reduce is not None:
+                raise ValueError(f"{label}: at a node group give a group of one node and no reduction (group "
+                                 f"'{where}' has {len(group)} nodes); for several elements give a line group and "
+                                 f"reduce={', '.join(map(repr, REDUCTIONS))}")
+            self._groups[(name, "results")] = group
+        else:
+            if where is not None:
+                model.tmesh.cells(where)
+            if reduce not in ("max", "min", "mean", "absmax"):
+                raise ValueError(f"{label}: over the elements of {('group ' + repr(where)) if where else 'the part'} "
+                                 f"say which value to record: reduce='max', 'min', 'mean' or 'absmax' (got {reduce!r})")
+        self._add_monitor(Monitor(name, part, where, "results", reduce, components=chosen))
+
+    def element_results(self, part: PartRef, where: str | None = None):
+        """Results element by element of ``part`` (within its cell group ``where``) at the current
+        state, in engineering terms (seed §1: the quantities of the rotated element frame), on
+        every rank — a :class:`~dolfinx_corot.result.ElementResults`:
+
+        * beams and bars: section forces at both ends of each element, (N, V, M) in 2D and
+          (N, Vy, Vz, T, My, Mz) in 3D, in the element's current axes;
+        * shells and membranes: membrane forces, moments, transverse shears per unit length,
+          top and bottom stresses and their von Mises values, in the element's current frame;
+        * solids: the Cauchy stress, its von Mises value and the Green–Lagrange strain at the
+          centre of each cell, in global axes.
+
+        Contact pressures are per slave node: ``pair.pressure()`` of what :meth:`contact` returned.
+        Collective."""
+        model = part.model
+        cells = model.tmesh.cells(part.name or None)
+        if where is not None:
+            cells = np.intersect1d(cells, model.tmesh.cells(where)).astype(np.int32)
+        label = f"{part.kind} '{part.name or 'all cells'}'" + (f" within '{where}'" if where else "")
+        return model.element_results(cells, label)
+
     def monitor_reaction(self, name: str, part: PartRef, where: str) -> None:
         """Record the force (sum over the nodes of ``where``) that the supports or prescribed
         displacements there exert on the structure, after every step: name_Fx, name_Fy, name_Mz
@@ -588,6 +648,17 @@ class Scene:
                 values.update(mon.part.monitor_values(mon.name, mon.where))
                 continue
             model = mon.part.model
+            if mon.kind == "results":
+                if mon.reduce is None and mon.where is not None:  # section forces at one node
+                    group = self._group(mon)
+                    at = group.X[0] + group.values(model)[0][: model.gdim]
+                    picked = self.element_results(mon.part).at(at)
+                    suffix = ""
+                else:
+                    picked = self.element_results(mon.part, mon.where).reduce(mon.reduce)
+                    suffix = f"_{mon.reduce}"
+                values.update({f"{mon.name}_{c}{suffix}": picked[c] for c in mon.components})
+                continue
             if mon.kind == "reaction":
                 # reaction on the structure = λ f_ext − f_int at the constrained nodes
                 fint = model.reaction(mon.where, system.model_array(model, system.internal_force()))

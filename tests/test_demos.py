@@ -174,7 +174,7 @@ def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
                 "tests/test_fields.py", "tests/test_reference.py", "tests/test_bad_input.py", "tests/test_monitors.py",
                 "tests/test_self_weight.py", "tests/test_cell_checks.py", "tests/test_stabilisation.py",
                 "tests/test_stability.py", "tests/test_convergence_scale.py", "tests/test_staging.py",
-                "tests/test_loads.py", "tests/test_plot.py", "tests/test_console.py"],
+                "tests/test_loads.py", "tests/test_plot.py", "tests/test_console.py", "tests/test_element_results.py"],
                tmp_path)
     # pytest's closing line on each rank: "N passed, M skipped in 62.63s" (+ " (0:01:02)" past a minute)
     summaries = [line for line in out.splitlines() if re.search(r"\d+ passed.* in [\d.]+s( \([\d:]+\))?\s*$", line)]

@@ -106,8 +106,11 @@ def _read_xdmf(path):
 
 
 def _check_file(path, model):
-    """The last step of the file holds the part's displacement (and rotation) at its nodes."""
+    """The last step of the file holds the part's displacement (and rotation) at its nodes, and its
+    element results as cell fields (each cell's mean over its points; compared as sorted sets of
+    values, the file's cell order being the ranks' local orders)."""
     X, state = model.nodes()   # every rank: all nodes (of V) with their state
+    results = model.element_results()
     if comm.rank != 0:
         return
     t, points, point_data = _read_xdmf(path)
@@ -129,6 +132,10 @@ def _check_file(path, model):
         assert np.abs(expect).max() > 1e-4 or not model.bending_blocks().any()  # membranes: fixed
     else:
         assert "rotation" not in point_data
+    for k, name in enumerate(results.components):
+        np.testing.assert_allclose(np.sort(point_data[name].ravel()), np.sort(results.values[:, :, k].mean(axis=1)),
+                                   rtol=1e-12, atol=1e-12 * np.abs(results.values).max(), err_msg=name)
+    assert np.abs(results.values).max() > 0.0
 
 
 @pytest.mark.parametrize("kind", sorted(SCENES))

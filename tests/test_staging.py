@@ -366,6 +366,8 @@ def test_a_beam_added_on_settled_ground_is_stress_free_with_approach_two(large):
     _, forces = beams[0].model.element_forces()
     assert comm.allreduce(len(forces)) == int(round(2 * WG))  # every element exists
     assert comm.allreduce(float(np.abs(forces).max(initial=0.0)), op=MPI.MAX) < 1e-9 * Q_TOP * WP
+    sections = beams[0].model.element_results()  # section forces since the activation: none
+    assert len(sections) == int(round(2 * WG)) and np.abs(sections.values).max() < 1e-9 * Q_TOP * WP
 
 
 def test_a_beam_added_on_settled_ground_carries_the_settlement_with_approach_one():
@@ -1001,6 +1003,10 @@ def test_a_shell_strip_added_on_settled_ground(approach):
     if approach == "II":
         assert after == pytest.approx(settled, rel=1e-12)
         assert _shell_forces(shells) < 1e-9 * resultant
+        for shell in shells:  # the resultants of the strip added undeformed: none
+            resultants = shell.model.element_results()
+            assert len(resultants) > 0
+            assert np.abs(resultants.values).max() < 1e-9 * Q_TOP
         return
     direct, direct_soil, _ = _ground_and_shell(False)
     dc.solve(direct, dc.LoadControl(steps=1))

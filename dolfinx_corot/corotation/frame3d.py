@@ -70,20 +70,15 @@ def initial_frame(X1, X2, v, R0):
 
 
 @numba.njit(cache=True)
-def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
-    """Basic deformations of the current configuration and B = ∂d̄/∂d (7, 12).
-
-    X1, X2: initial nodal positions; u1, u2: displacements; R1, R2: nodal
-    rotations; R0: initial element frame. Fills th1, th2 (3,) and B; returns ū.
-    """
+def current_frame(X1, X2, u1, u2, R1, R2, R0, Rr, p1, p2):
+    """The current element frame Rr (3, 3) (columns e1, e2, e3) and p1, p2 (3,) = R_i R0 j;
+    returns the current length l."""
     dt = u1.dtype
     dx = np.empty(3, dtype=dt)
     for k in range(3):
         dx[k] = X2[k] + u2[k] - X1[k] - u1[k]
     l = np.sqrt(dot(dx, dx))
     e1 = dx / l
-    p1 = np.empty(3, dtype=dt)
-    p2 = np.empty(3, dtype=dt)
     for k in range(3):
         p1[k] = R1[k, 0] * R0[0, 1] + R1[k, 1] * R0[1, 1] + R1[k, 2] * R0[2, 1]
         p2[k] = R2[k, 0] * R0[0, 1] + R2[k, 1] * R0[1, 1] + R2[k, 2] * R0[2, 1]
@@ -93,11 +88,28 @@ def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
     e3 = e3 / np.sqrt(dot(e3, e3))
     e2 = np.empty(3, dtype=dt)
     cross(e3, e1, e2)
-    Rr = np.empty((3, 3), dtype=dt)
     for k in range(3):
         Rr[k, 0] = e1[k]
         Rr[k, 1] = e2[k]
         Rr[k, 2] = e3[k]
+    return l
+
+
+@numba.njit(cache=True)
+def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
+    """Basic deformations of the current configuration and B = ∂d̄/∂d (7, 12).
+
+    X1, X2: initial nodal positions; u1, u2: displacements; R1, R2: nodal
+    rotations; R0: initial element frame. Fills th1, th2 (3,) and B; returns ū.
+    """
+    dt = u1.dtype
+    p1 = np.empty(3, dtype=dt)
+    p2 = np.empty(3, dtype=dt)
+    Rr = np.empty((3, 3), dtype=dt)
+    l = current_frame(X1, X2, u1, u2, R1, R2, R0, Rr, p1, p2)
+    p = 0.5 * (p1 + p2)
+    e1 = Rr[:, 0].copy()
+    e2 = Rr[:, 1].copy()
     T = np.empty((3, 3), dtype=dt)
     Rb = np.empty((3, 3), dtype=dt)
     R0c = np.empty((3, 3), dtype=dt)

@@ -65,3 +65,29 @@ def local_stiffness(xy, props, K):
                 for r in range(3):
                     acc += B[r, i] * (D[r, 0] * B[0, j] + D[r, 1] * B[1, j] + D[r, 2] * B[2, j])
                 K[i, j] += w * acc
+
+
+@numba.njit(cache=True)
+def centre_B(xy):
+    """The strain matrix (3, 8) of the Q4 at its centre (ξ = η = 0) for the local node
+    coordinates xy (4, 2), counter-clockwise: ε = (ε_xx, ε_yy, γ_xy) = B d̄."""
+    dN = np.empty((2, 4))
+    for a in range(4):
+        dN[0, a] = 0.25 * _NODES[a, 0]
+        dN[1, a] = 0.25 * _NODES[a, 1]
+    J00 = J01 = J10 = J11 = 0.0
+    for a in range(4):
+        J00 += dN[0, a] * xy[a, 0]
+        J01 += dN[0, a] * xy[a, 1]
+        J10 += dN[1, a] * xy[a, 0]
+        J11 += dN[1, a] * xy[a, 1]
+    det = J00 * J11 - J01 * J10
+    B = np.zeros((3, 8))
+    for a in range(4):
+        nx = (J11 * dN[0, a] - J01 * dN[1, a]) / det
+        ny = (-J10 * dN[0, a] + J00 * dN[1, a]) / det
+        B[0, 2 * a] = nx
+        B[1, 2 * a + 1] = ny
+        B[2, 2 * a] = ny
+        B[2, 2 * a + 1] = nx
+    return B

@@ -51,7 +51,7 @@ _GP = np.array([[1.0 / 6.0, 1.0 / 6.0], [2.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 2.0 
 
 
 @numba.njit(cache=True)
-def _plane_stress(E, nu):
+def plane_stress(E, nu):
     D = np.zeros((3, 3))
     c = E / (1.0 - nu * nu)
     D[0, 0] = c
@@ -86,7 +86,7 @@ def opt_membrane(xy, E, nu, t):
     y12, y21, y13, y31, y23, y32 = y1 - y2, y2 - y1, y1 - y3, y3 - y1, y2 - y3, y3 - y2
     A = 0.5 * (x21 * y31 - x31 * y21)
     V = A * t
-    D = _plane_stress(E, nu)
+    D = plane_stress(E, nu)
     a6, a3 = ALPHA_B / 6.0, ALPHA_B / 3.0
     L = np.zeros((9, 3))
     L[0, 0], L[0, 2] = y23, x32
@@ -266,7 +266,7 @@ def local_stiffness(xy, props, K):
             for b in range(9):
                 K[mdofs[a], mdofs[b]] += Km[a, b]
     else:
-        Dm = _plane_stress(E, nu) * t
+        Dm = plane_stress(E, nu) * t
         _add_btdb(Bm, Dm, A, np.array([0, 1, 6, 7, 12, 13]), K)
     if props[BENDING] == 0.0:
         return
@@ -285,7 +285,7 @@ def local_stiffness(xy, props, K):
                 for b in range(18):
                     K[a, b] += kd * g[a] * g[b]
     # bending
-    Db = _plane_stress(E, nu) * (t * t * t / 12.0)
+    Db = plane_stress(E, nu) * (t * t * t / 12.0)
     bend = np.array([2, 3, 4, 8, 9, 10, 14, 15, 16])
     for q in range(3):
         _add_btdb(bending_B(xy, _GP[q, 0], _GP[q, 1]), Db, A / 3.0, bend, K)

@@ -16,23 +16,32 @@ class FieldWriter:
     ``displacement`` (gdim components, P1 on the part's mesh: a quadratic solid's
     displacement is interpolated at the mesh nodes) and ``rotation`` (2D: the angle θ_z;
     3D: the rotation vector, norm ≤ π). ParaView's "Warp By Vector" shows the
-    deformed shape. Close it (or use it in a ``with`` block) to flush the file.
+    deformed shape. With ``results=True`` (the default) the element results in engineering terms
+    (:meth:`dolfinx_corot.Scene.element_results`) are cell fields beside them, one per
+    component, named by it: a beam's section forces N, V, M (3D: N, Vy, Vz, T, My, Mz) as the mean
+    of its two ends, a shell's or membrane's resultants and face stresses, a solid's Cauchy stress,
+    von Mises stress and Green–Lagrange strain at the cell's centre; cells that do not exist carry
+    0. Close it (or use it in a ``with`` block) to flush the file.
     A scene whose parts live on several meshes writes one file per mesh,
     ``path`` with ``_0``, ``_1``, … before the extension.
     """
 
-    def __init__(self, scene, path: str, model=None):
+    def __init__(self, scene, path: str, model=None, results: bool = True):
         model = scene.model if model is None else model
         self.parts = []
         self.path = path
         if model.coupled:
             stem, ext = os.path.splitext(path)
-            self.parts = [FieldWriter(scene, f"{stem}_{i}{ext}", m) for i, m in enumerate(model.models)]
+            self.parts = [FieldWriter(scene, f"{stem}_{i}{ext}", m, results) for i, m in enumerate(model.models)]
             return
         mesh = model.V.mesh
         self.model = model
         self.u = dolfinx.fem.Function(dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=model.gdim),
                                       name="displacement")
+        self.cell_fields = {}
+        if results and getattr(model, "section_components", ()):
+            dg0 = dolfinx.fem.FunctionSpace(mesh, ("DG", 0))
+            self.cell_fields = {c: dolfinx.fem.Function(dg0, name=c) for c in model.section_components}
         self.file = dolfinx.io.XDMFFile(mesh.comm, path, "w")
         self.file.write_mesh(mesh)
 
@@ -47,6 +56,13 @@ class FieldWriter:
         rotation = self.model.rotation_field()
         if rotation is not None:
             self.file.write_function(rotation, t)
+        if self.cell_fields:
+            local = self.model.element_results(gather=False)
+            for k, (name, f) in enumerate(self.cell_fields.items()):
+                f.x.array[:] = 0.0
+                f.x.array[f.function_space.dofmap.list.array[local.cells]] = local.values[:, :, k].mean(axis=1)
+                f.x.scatter_forward()
+                self.file.write_function(f, t)
 
     def close(self) -> None:
         for part in self.parts:

@@ -139,6 +139,44 @@ def evaluate_all(X, S, props, large_rotations, F, K):
         _evaluate(X[e], S[e], props[e], large_rotations, True, F[e], K[e])
 
 
+@numba.njit(cache=True)
+def section_forces(X, S, props, large_rotations, out, axes):
+    """out (2, 6): the section forces (N, Vy, Vz, T, My, Mz) at ends 1 and 2 of one element, in its
+    current axes (the initial ones for a geometrically linear analysis): the resultants on the
+    cross-section's face whose outward normal is +e1, i.e. −Rᵀf₁ at end 1 and +Rᵀf₂ at end 2 of the
+    nodal forces f the element exerts (N > 0 in tension); axes (3, 3): rows e1, e2, e3."""
+    f = np.empty(12)
+    K = np.empty((12, 12))
+    _evaluate(X, S, props, large_rotations, False, f, K)
+    R0 = np.empty((3, 3))
+    frame3d.initial_frame(X[0], X[1], props[law.VX:law.VZ + 1], R0)
+    Rr = R0
+    if large_rotations:
+        u = np.empty((2, 3))
+        R = np.empty((2, 3, 3))
+        nodal_states(S, u, R)
+        Rr = np.empty((3, 3))
+        frame3d.current_frame(X[0], X[1], u[0], u[1], R[0], R[1], R0, Rr, np.empty(3), np.empty(3))
+    for a in range(2):
+        sign = -1.0 if a == 0 else 1.0
+        for i in range(3):
+            F = 0.0
+            M = 0.0
+            for k in range(3):
+                F += Rr[k, i] * f[6 * a + k]
+                M += Rr[k, i] * f[6 * a + 3 + k]
+            out[a, i] = sign * F
+            out[a, 3 + i] = sign * M
+    axes[:, :] = Rr.T
+
+
+@numba.njit(cache=True)
+def section_forces_all(X, S, props, large_rotations, out, axes):
+    """:func:`section_forces` of every element: X (n, 2, 3), S (n, 2, 7) → out (n, 2, 6), axes (n, 3, 3)."""
+    for e in range(X.shape[0]):
+        section_forces(X[e], S[e], props[e], large_rotations, out[e], axes[e])
+
+
 @numba.njit(cache=True, inline="always")
 def _tabulate(w, c, X, f, K, tangent):
     """The element function of the DOLFINx kernels (see :mod:`.ufcx`)."""

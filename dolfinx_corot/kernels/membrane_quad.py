@@ -17,7 +17,7 @@ import numba
 import numpy as np
 
 from ..corotation import frame_quad as frame
-from ..corotation.transform import linear_force, stiffness
+from ..corotation.transform import linear_force, positions, stiffness
 from ..elements import membrane_quad as law
 from .spatial import H, pack_constants, unpack_constants
 from .ufcx import lazy_kernels, tabulate_tensor_kernels
@@ -129,6 +129,52 @@ def _evaluate_ccw(Xc, u, edata, large_rotations, tangent, f24, K24):
                 Bn = CCW[b]
                 for m in range(3):
                     K24[6 * A + k, 6 * Bn + m] = K[3 * a + k, 3 * b + m]
+
+
+@numba.njit(cache=True)
+def resultants(X, S, props, large_rotations, out, axes):
+    """out (16,): the components of :data:`dolfinx_corot.kernels.shell3d.RESULTANTS` of one
+    membrane (X (4, 3), S (4, 7) in DOLFINx vertex order) at its centre, in its current frame (the
+    initial one for a geometrically linear analysis): membrane forces N = t D ε̄(0, 0), the
+    stress N/t on both faces and its von Mises value; no moments or shears. axes (3, 3): rows
+    e1, e2, e3."""
+    Xc = np.empty((4, 3))
+    u = np.empty((4, 3))
+    for a in range(4):
+        Xc[a] = X[CCW[a]]
+        u[a] = S[CCW[a], :3]
+    edata = np.empty(NEDATA)
+    element_data(Xc, props, edata)
+    R0, xbar0, _ = unpack_constants(edata, 4, 8)
+    dbar = np.empty(8)
+    B = np.empty((8, 12))
+    if large_rotations:
+        frame.basic(Xc, u, xbar0, dbar, B)
+        R = np.empty((3, 3))
+        frame.frame(positions(Xc, u), R)
+    else:
+        frame.basic(Xc, np.zeros((4, 3)), xbar0, np.empty(8), B)
+        dbar[:] = B @ u.ravel()
+        R = R0
+    E, nu, t = props[law.E_], props[law.NU], props[law.T]
+    c = E / (1.0 - nu * nu)
+    eps = law.centre_B(np.ascontiguousarray(xbar0[:, :2])) @ dbar
+    N = np.array([c * (eps[0] + nu * eps[1]), c * (nu * eps[0] + eps[1]), c * (1.0 - nu) / 2.0 * eps[2]]) * t
+    out[:] = 0.0
+    out[0:3] = N
+    s = N / t
+    mises = np.sqrt(max(s[0] * s[0] - s[0] * s[1] + s[1] * s[1] + 3.0 * s[2] * s[2], 0.0))
+    for side in range(2):
+        out[8 + 3 * side:11 + 3 * side] = s
+        out[14 + side] = mises
+    axes[:, :] = R.T
+
+
+@numba.njit(cache=True)
+def resultants_all(X, S, props, large_rotations, out, axes):
+    """:func:`resultants` of every element: X (n, 4, 3), S (n, 4, 7) → out (n, 16), axes (n, 3, 3)."""
+    for e in range(X.shape[0]):
+        resultants(X[e], S[e], props[e], large_rotations, out[e], axes[e])
 
 
 @numba.njit(cache=True, inline="always")

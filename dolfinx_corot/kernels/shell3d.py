@@ -157,6 +157,91 @@ def evaluate(X, S, props, large_rotations, f, K):
     evaluate_cached(X, S, props, edata, large_rotations, f, K)
 
 
+#: the components of :func:`resultants`
+RESULTANTS = ("Nxx", "Nyy", "Nxy", "Mxx", "Myy", "Mxy", "Qx", "Qy", "sxx_top", "syy_top", "sxy_top",
+              "sxx_bottom", "syy_bottom", "sxy_bottom", "mises_top", "mises_bottom")
+
+
+@numba.njit(cache=True)
+def _mises_plane(sxx, syy, sxy):
+    return np.sqrt(max(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy, 0.0))
+
+
+@numba.njit(cache=True)
+def resultants(X, S, props, edata, large_rotations, out, axes):
+    """out (16,) = :data:`RESULTANTS` of one element in its current frame (e1 along side 1–2, e3
+    its normal; the initial frame for a geometrically linear analysis), per unit length:
+
+    * membrane forces N = t D ε̄ with ε̄ the mean (constant-strain) membrane strain of the
+      deformational displacements;
+    * moments M = ∫ σ z dz = −D_b κ at the centroid (κ = (w,xx, w,yy, 2w,xy) of the DKT);
+    * transverse shears from equilibrium, Qx = Mxx,x + Mxy,y, Qy = Mxy,x + Myy,y (the DKT
+      moments vary linearly over the element);
+    * stresses on the top (z = +t/2, the e3 side) and bottom faces, σ = N/t ± 6M/t², and
+      their von Mises values (plane stress).
+
+    axes (3, 3): rows e1, e2, e3 of that frame.
+    """
+    R0, xbar0, Kbar = unpack_constants(edata, 3, 18)
+    bending = props[law.BENDING] != 0.0
+    u = np.empty((3, 3))
+    R = np.empty((3, 3, 3))
+    nodal_states(S, u, R)
+    dbar = np.empty(18)
+    if large_rotations:
+        Rr, _, _, _, _, _, _, _, _, d = frame.parts(X, u, R, R0, xbar0, bending)
+        dbar[:] = d
+        axes[:, :] = Rr.T
+    else:  # d̄ = B₀ d in the initial frame
+        B = np.empty((18, 18))
+        for a in range(3):
+            R[a] = np.eye(3)
+        frame.basic(X, np.zeros((3, 3)), R, R0, xbar0, np.empty(18), B, bending)
+        d = np.empty(18)
+        rotation_vector_dofs(S, d)
+        dbar[:] = B @ d
+        axes[:, :] = R0.T
+    xy = np.ascontiguousarray(xbar0[:, :2])
+    E, nu, t = props[law.E_], props[law.NU], props[law.T]
+    D = law.plane_stress(E, nu)
+    Bm, _ = law.membrane_B(xy)
+    uv = np.array([dbar[0], dbar[1], dbar[6], dbar[7], dbar[12], dbar[13]])
+    N = t * (D @ (Bm @ uv))
+    out[:] = 0.0
+    out[0:3] = N
+    M = np.zeros(3)
+    if bending:
+        wt = np.array([dbar[2], dbar[3], dbar[4], dbar[8], dbar[9], dbar[10], dbar[14], dbar[15], dbar[16]])
+        Db = D * (t * t * t / 12.0)
+        M = -(Db @ (law.bending_B(xy, 1.0 / 3.0, 1.0 / 3.0) @ wt))
+        M0 = -(Db @ (law.bending_B(xy, 0.0, 0.0) @ wt))
+        dxi = -(Db @ (law.bending_B(xy, 1.0, 0.0) @ wt)) - M0
+        deta = -(Db @ (law.bending_B(xy, 0.0, 1.0) @ wt)) - M0
+        # ∂/∂x, ∂/∂y = J⁻¹ (∂/∂ξ, ∂/∂η), J = [[x2 − x1, y2 − y1], [x3 − x1, y3 − y1]]
+        j00, j01 = xy[1, 0] - xy[0, 0], xy[1, 1] - xy[0, 1]
+        j10, j11 = xy[2, 0] - xy[0, 0], xy[2, 1] - xy[0, 1]
+        det = j00 * j11 - j01 * j10
+        dx = (j11 * dxi - j01 * deta) / det
+        dy = (-j10 * dxi + j00 * deta) / det
+        out[3:6] = M
+        out[6] = dx[0] + dy[2]
+        out[7] = dx[2] + dy[1]
+    for side in range(2):
+        z = 1.0 if side == 0 else -1.0
+        sig = N / t + z * 6.0 * M / (t * t)
+        out[8 + 3 * side:11 + 3 * side] = sig
+        out[14 + side] = _mises_plane(sig[0], sig[1], sig[2])
+
+
+@numba.njit(cache=True)
+def resultants_all(X, S, props, large_rotations, out, axes):
+    """:func:`resultants` of every element: X (n, 3, 3), S (n, 3, 7) → out (n, 16), axes (n, 3, 3)."""
+    edata = np.empty(NEDATA)
+    for e in range(X.shape[0]):
+        element_data(X[e], props[e], edata)
+        resultants(X[e], S[e], props[e], edata, large_rotations, out[e], axes[e])
+
+
 @numba.njit(cache=True, inline="always")
 def _tabulate(w, c, X, f, K, tangent):
     """The element function of the DOLFINx kernels (see :mod:`.ufcx`)."""

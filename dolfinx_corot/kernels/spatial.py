@@ -139,3 +139,11 @@ def since_activation(X, S, A):
             qi[k] = -A[a, 3 + k]
         Sa[a, 3:7] = quat_mul(S[a, 3:7].copy(), qi)
     return Xa, Sa
+
+
+@numba.njit(cache=True)
+def since_activation_all(X, S, A, Xa, Sa):
+    """(X + u_A, S since A) of every element (see :func:`since_activation`): X (n, m, 3),
+    S and A (n, m, 7) → Xa, Sa."""
+    for e in range(X.shape[0]):
+        Xa[e], Sa[e] = since_activation(X[e], S[e], A[e])

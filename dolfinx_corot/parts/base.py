@@ -26,6 +26,7 @@ import dolfinx.mesh
 
 from ..conditions import Condition
 from ..io.mesh import TaggedMesh
+from ..result import ElementResults
 from .groups import NodeGroup, gather_group
 from .surface import Surface, SurfaceError
 
@@ -496,6 +497,40 @@ class Part:
         join = (lambda k: None if parts[0][k] is None else np.concatenate([p[k] for p in parts]))
         return {"cell": self.V.mesh.topology.cell_name(), "gdim": self.gdim, "X": join(0), "u": join(1),
                 "exists": join(2), "rotation": join(3), "size": join(4), "kind": self.kind_name}
+
+    # -- element results ------------------------------------------------------------
+    def element_results(self, cells: np.ndarray | None = None, label: str = "",
+                        gather: bool = True) -> ElementResults:
+        """Results per element at the current state (:class:`~dolfinx_corot.result.ElementResults`)
+        of the given local cells (None: every cell with an existing element), gathered on every
+        rank (collective); gather=False: this rank's owned cells only, by their local index."""
+        raise ValueError(f"{self.kind_name} parts have no element results")
+
+    def _result_cells(self, cells: np.ndarray | None) -> np.ndarray:
+        """The owned cells among ``cells`` (None: all) that carry an existing element."""
+        n_owned = self.V.mesh.topology.index_map(self.tdim).size_local
+        active = self._cells_active() & (self.cells_existing() if self.is_staged() else True)
+        keep = np.zeros(n_owned, dtype=bool)
+        if cells is None:
+            keep[:] = True
+        else:
+            cells = np.asarray(cells, dtype=np.int64)
+            keep[cells[cells < n_owned]] = True
+        return np.flatnonzero(keep & active[:n_owned]).astype(np.int32)
+
+    def _gather_results(self, kind: str, components, cells: np.ndarray, points: np.ndarray, values: np.ndarray,
+                        axes: np.ndarray | None, label: str, gather: bool = True) -> ElementResults:
+        """The owned cells' results of every rank, ordered by the cells' input index (gather=False:
+        this rank's, by local index)."""
+        if not gather:
+            return ElementResults(kind, components, cells, points, values, axes, label)
+        index = np.asarray(self.V.mesh.topology.original_cell_index, dtype=np.int64)[cells]
+        found = self.comm.allgather((index, points, values, axes))
+        join = (lambda k: np.concatenate([f[k] for f in found]))
+        index = join(0)
+        order = np.argsort(index, kind="stable")
+        return ElementResults(kind, components, index[order], join(1)[order], join(2)[order],
+                              None if axes is None else join(3)[order], label)
 
     def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray | None:
         """The drawn size of the given owned cells (see :meth:`drawing`); None: none."""

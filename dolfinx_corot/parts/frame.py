@@ -31,6 +31,8 @@ from ..io.mesh import TaggedMesh
 from ..loads import FollowerLoad
 from ..kernels import beam3d as kernels3d
 from ..kernels import line2d as kernels2d
+from ..kernels.spatial import since_activation_all
+from ..result import ElementResults
 from .base import AdditiveState, Part, PartRef
 from .cells import MeshError, check_geometry_degree, mesh_extent, refuse
 from .surface import Surface, SurfaceError, gather_surface
@@ -371,6 +373,67 @@ class LineFrame(Part):
         added undeformed in a deformed configuration, approach II); 0 otherwise."""
         return self._activations(cells)[:, :, : self.gdim] if self._staged_shift() else 0.0
 
+    def _element_states(self, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(X (cells, nodes, 3), S (cells, nodes, state_size)): the reference positions of the
+        elements' nodes and their states since the elements appeared (approach II: reference
+        X + U_os, states U − U_os with rotations R R_osᵀ), as the kernels read them."""
+        blocks = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)[cells]
+        X = np.zeros(blocks.shape + (3,))
+        X[:, :, : self.gdim] = self.reference[blocks]
+        S = self.state.x.array.reshape(-1, self.state_size)[blocks]
+        if self._staged_shift():
+            A = self._activations(cells)
+            if self.state_size == 7:  # multiplicative rotations
+                Xa, Sa = np.empty_like(X), np.empty_like(S)
+                since_activation_all(X, S, A, Xa, Sa)
+                return Xa, Sa
+            X[:, :, : self.gdim] += A[:, :, : self.gdim]
+            S = S - A
+        return X, S
+
+    _load_factor = 0.0  # of the residual last assembled (the converged state's, after a solve)
+
+    def set_follower_factor(self, load_factor: float) -> None:
+        self._load_factor = float(load_factor)
+
+    def _span_loads(self, cells: np.ndarray) -> np.ndarray:
+        """(cells, 2, ndof) the nodal forces and moments (global axes) by which the uniform loads
+        on the given line elements — weights, dead loads per length, 2D follower loads — act on
+        their nodes at the current load factor (in a staged run at full value: the state at a
+        stage's end). The element's end forces less these are the forces its neighbours exert on
+        it: the section forces of a loaded span (its fixed-end forces included)."""
+        g, nd = self.gdim, self.ndof
+        out = np.zeros((len(cells), 2, nd))
+        if not len(cells):
+            return out
+        lam, staged = self._load_factor, self.is_staged()
+        blocks_of = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)
+        for label, where, q, amplitude, condition in self._distributed:
+            hit = np.isin(cells, self._weight_cells(label, where)) if condition.exists else np.zeros(0, bool)
+            if not hit.any():
+                continue
+            c = 1.0 if staged else (lam if amplitude is None else float(amplitude(lam)))
+            sub = cells[hit]
+            X = self.reference[blocks_of[sub]] + self._activation_translations(sub)
+            forces, moments = uniform_load.line_loads(X, q(sub, X) if callable(q) else q, self._bending[sub])
+            out[hit, :, :g] += c * forces
+            out[hit, :, g:] += c * moments.reshape(len(sub), 2, nd - g)
+        for load in self.followers:
+            if load.condition is not None and not load.condition.exists:
+                continue
+            where = {int(cell): k for k, cell in enumerate(load.cells)}
+            hit = np.array([int(cell) in where for cell in cells], dtype=bool)
+            if hit.any():
+                c = 1.0 if staged else load.factor(lam)
+                f, _ = load.evaluate()
+                out[hit] += c * f[[where[int(cell)] for cell in cells[hit]]].reshape(-1, 2, nd)
+        return out
+
+    def _current_points(self, cells: np.ndarray) -> np.ndarray:
+        """(cells, nodes, gdim) the current positions of the elements' nodes."""
+        blocks = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)[cells]
+        return self.reference[blocks] + self.state.x.array.reshape(-1, self.state_size)[blocks][:, :, : self.gdim]
+
     def bending_blocks(self) -> np.ndarray:
         """Local blocks (owned and ghost) that a bending element on this rank touches."""
         nblocks = self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts
@@ -443,18 +506,47 @@ class Frame2D(AdditiveState, LineFrame):
         """(cells, forces): the owned cells with existing elements and their end forces and
         moments (n, 6) in global axes, (Fx, Fy, M) at node 1 then node 2 — the forces the element
         exerts on its nodes' equilibrium, f_int."""
-        n_owned = self.tmesh.mesh.topology.index_map(1).size_local
-        cells = np.flatnonzero(self._cells_active()[:n_owned]).astype(np.int32)
-        blocks = self.V.dofmap.list.array.reshape(-1, 2)[cells]
-        X = self.reference[blocks] + self._activation_translations(cells)
-        D = self.state.x.array.reshape(-1, self.ndof)[blocks].reshape(-1, 2 * self.ndof)
-        if self._staged_shift():
-            D = D - self._activations(cells).reshape(-1, 2 * self.ndof)
+        cells = self._result_cells(None)
+        return cells, self._end_forces(cells)[0]
+
+    def _end_forces(self, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(F (n, 6) the elements' nodal forces in global axes, X (n, 2, 2) their reference nodes)."""
+        X, S = self._element_states(cells)
+        X = np.ascontiguousarray(X[:, :, :2])
         F = np.zeros((len(cells), 6))
         K = np.zeros((len(cells), 6, 6))
-        self.kernels.evaluate_all(np.ascontiguousarray(X), np.ascontiguousarray(D), self.cell_properties(cells),
+        self.kernels.evaluate_all(X, np.ascontiguousarray(S.reshape(-1, 6)), self.cell_properties(cells),
                                   self.large_rotations, F, K)
-        return cells, F
+        return F, X
+
+    section_components = ("N", "V", "M")
+
+    def element_results(self, cells: np.ndarray | None = None, label: str = "",
+                        gather: bool = True) -> ElementResults:
+        """Section forces (N, V, M) at both ends of every beam and bar, in the element's axes — e1
+        along the current chord (the initial one in a geometrically linear analysis), e2 = e1
+        turned by +90° — as the resultants on the face whose outward normal is +e1: −f₁ at end 1
+        and +f₂ at end 2 of the nodal forces f the element exerts (seed §1: the engineering
+        quantities of the rotated element frame). N > 0 in tension; M > 0 bends the element
+        concave towards +e2 (the −e2 fibres in tension), M = EIκ; dM/ds = −V (as Mz and Vy in
+        3D). An element under a uniform load (weight, load per length) reports the forces its
+        neighbours exert on it, its nodal share of the load taken off: the ends of a loaded span,
+        fixed-end forces included (a linear beam's are then exact at the nodes)."""
+        cells = self._result_cells(cells)
+        F, X = self._end_forces(cells)
+        F = F - self._span_loads(cells).reshape(len(cells), 6)
+        x = self._current_points(cells) if self.large_rotations else X
+        chord = x[:, 1] - x[:, 0]
+        e1 = chord / np.linalg.norm(chord, axis=1)[:, None]
+        e2 = np.stack([-e1[:, 1], e1[:, 0]], axis=1)
+        values = np.empty((len(cells), 2, 3))
+        for end, sign in ((0, -1.0), (1, 1.0)):
+            f = F[:, 3 * end: 3 * end + 2]
+            values[:, end, 0] = sign * np.einsum("ij,ij->i", f, e1)
+            values[:, end, 1] = sign * np.einsum("ij,ij->i", f, e2)
+            values[:, end, 2] = sign * F[:, 3 * end + 2]
+        return self._gather_results("section forces", self.section_components, cells, self._current_points(cells),
+                                    values, np.stack([e1, e2], axis=1), label, gather)
 
     def surface(self, where: str, body: str | None = None) -> Surface:
         """The beams of line group ``where`` as a two-sided contact surface: the axis offset by half
@@ -572,6 +664,31 @@ class Frame3D(Rotations3D, LineFrame):
                           N0, *v])
         bending = values["EIy"] > 0.0 or values["EIz"] > 0.0
         return self.add_elements(where, props, bending, kind)
+
+    section_components = ("N", "Vy", "Vz", "T", "My", "Mz")
+
+    def element_results(self, cells: np.ndarray | None = None, label: str = "",
+                        gather: bool = True) -> ElementResults:
+        """Section forces (N, Vy, Vz, T, My, Mz) at both ends of every beam and bar, in the
+        element's current axes (e1 along the chord, e2 from the nodal rotations of the section's
+        y axis; the initial axes in a geometrically linear analysis): the resultant force and
+        moment on the face whose outward normal is +e1 (−f₁ at end 1, +f₂ at end 2 of the nodal
+        forces the element exerts, less its nodal share of a uniform load on it, as in 2D). N > 0
+        in tension, T the torque; My > 0 puts the +e3 fibres in tension, Mz > 0 the −e2 fibres;
+        dMy/ds = Vz, dMz/ds = −Vy."""
+        cells = self._result_cells(cells)
+        X, S = self._element_states(cells)
+        values = np.empty((len(cells), 2, 6))
+        axes = np.empty((len(cells), 3, 3))
+        self.kernels.section_forces_all(np.ascontiguousarray(X), np.ascontiguousarray(S),
+                                        np.ascontiguousarray(self.cell_properties(cells)), self.large_rotations,
+                                        values, axes)
+        span = self._span_loads(cells)  # less the span loads' nodal share, in the element's axes
+        for end, sign in ((0, -1.0), (1, 1.0)):
+            values[:, end, :3] -= sign * np.einsum("nij,nj->ni", axes, span[:, end, :3])
+            values[:, end, 3:] -= sign * np.einsum("nij,nj->ni", axes, span[:, end, 3:])
+        return self._gather_results("section forces", self.section_components, cells, self._current_points(cells),
+                                    values, axes, label, gather)
 
     def surface(self, where: str, body: str | None = None) -> Surface:
         """The nodes of the beams of line group ``where`` as contact slaves: each meets a surface at

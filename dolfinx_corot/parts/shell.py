@@ -21,6 +21,7 @@ from ..io.mesh import TaggedMesh
 from ..kernels import membrane_quad as kernels_mq
 from ..kernels import shell3d as kernels_shell
 from ..loads import FollowerLoad
+from ..result import ElementResults
 from .base import PartRef
 from .cells import mesh_extent, quadrilateral_problems, refuse, triangle_problems
 from .frame import Frame3D, LineFrame, Rotations3D
@@ -97,6 +98,28 @@ class Surface3D(Rotations3D, LineFrame):
             return p * n / np.linalg.norm(n, axis=1)[:, None]
         self._distributed.append((label, where, along_initial_normals, amplitude, condition))
         return condition
+
+    section_components = kernels_shell.RESULTANTS
+
+    def element_results(self, cells: np.ndarray | None = None, label: str = "",
+                        gather: bool = True) -> ElementResults:
+        """Stress resultants per unit length at the centre of every shell and membrane, in the
+        element's current frame (triangles: e1 along side 1–2; quadrilaterals: e1 between the
+        diagonals; e3 the normal by the right-hand rule over the nodes; the initial frame in a
+        geometrically linear analysis): membrane forces Nxx, Nyy, Nxy, moments Mxx, Myy, Mxy
+        (M = ∫σ z dz, z along e3), transverse shears Qx, Qy (from the moments' equilibrium), the
+        stresses σ = N/t ± 6M/t² on the top (+e3) and bottom faces and their von Mises values.
+        Membranes have no moments or shears. See :func:`dolfinx_corot.kernels.shell3d.resultants`."""
+        cells = self._result_cells(cells)
+        X, S = self._element_states(cells)
+        values = np.empty((len(cells), len(self.section_components)))
+        axes = np.empty((len(cells), 3, 3))
+        self.kernels.resultants_all(np.ascontiguousarray(X), np.ascontiguousarray(S),
+                                    np.ascontiguousarray(self.cell_properties(cells)), self.large_rotations,
+                                    values, axes)
+        centre = self._current_points(cells).mean(axis=1)[:, None, :]
+        return self._gather_results("shell resultants", self.section_components, cells, centre, values[:, None, :],
+                                    axes, label, gather)
 
     def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray:
         """The thickness."""

@@ -42,7 +42,8 @@ from ..conditions import Condition
 from ..continuum.kinematics import deformation_gradient
 from ..continuum.laws import first_piola, lame
 from ..io.mesh import TaggedMesh
-from ..materials import Elastic
+from ..materials import Elastic, NeoHookean
+from ..result import ElementResults
 from .base import AdditiveState, Part, PartRef, finite_vector
 from .cells import check_geometry_degree, check_solid_cells
 from .surface import Surface, SurfaceError, gather_surface
@@ -505,34 +506,86 @@ class Solid(AdditiveState, Part):
         self.activation_reference.x.array.reshape(-1, self.gdim)[dg] -= u
         self.state.x.array[:] = 0.0
 
-    def cell_stress(self) -> np.ndarray:
-        """Cauchy stress at the centre of every owned cell, (cells, gdim, gdim): σ = P Fᵀ / det F
-        at large rotations, the small-strain stress otherwise (non-existing cells: 0)."""
+    def _result_fields(self):
+        """UFL (σ (gdim, gdim) the Cauchy stress, σ_zz (plane strain; None in 3D), E the
+        Green–Lagrange strain, or the small strain ε in a geometrically linear analysis) of the
+        current state; staged cells by their own kinematics. The initial stress σ₀ enters σ; in
+        plane strain σ_zz is that of the law alone (σ₀ has no zz component)."""
         u = self.state
+        lmbda, mu = lame(self.E, self.nu)
+        I = ufl.Identity(self.gdim)
+        S0 = self.initial_stress
         if self.existing is not None:
-            lmbda, mu = lame(self.E, self.nu)
             measure, _ = self._staged_kinematics(u)
-            S0 = self.initial_stress
-            if not self.large_rotations:
-                sigma = lmbda * ufl.tr(measure) * ufl.Identity(self.gdim) + 2.0 * mu * measure
-                sigma = sigma if S0 is None else sigma + S0
-            else:
-                P = first_piola(self.law, measure, lmbda, mu)
-                P = P if S0 is None else P + ufl.dot(measure, S0)
-                sigma = ufl.dot(P, measure.T) / ufl.det(measure)
-            sigma = self.existing * sigma
         elif self.large_rotations:
-            F = ufl.Identity(self.gdim) + self._gradient(u)
-            P = self.stress(u) if self.initial_stress is None else self.stress(u) + ufl.dot(F, self.initial_stress)
-            sigma = ufl.dot(P, F.T) / ufl.det(F)
+            measure = I + self._gradient(u)
         else:
-            sigma = self.stress(u) if self.initial_stress is None else self.stress(u) + self.initial_stress
+            measure = ufl.sym(self._gradient(u))
+        if not self.large_rotations:
+            sigma = lmbda * ufl.tr(measure) * I + 2.0 * mu * measure
+            sigma = sigma if S0 is None else sigma + S0
+            szz = lmbda * ufl.tr(measure)
+            strain = measure
+        else:
+            F = measure
+            P = first_piola(self.law, F, lmbda, mu)
+            P = P if S0 is None else P + ufl.dot(F, S0)
+            J = ufl.det(F)
+            sigma = ufl.dot(P, F.T) / J
+            strain = 0.5 * (F.T * F - I)
+            # plane strain, F_zz = 1: neo-Hookean τ_zz = λ ln J; St Venant–Kirchhoff S_zz = λ tr E
+            szz = lmbda * (ufl.ln(J) if issubclass(self.law, NeoHookean) else ufl.tr(strain)) / J
+        return sigma, (szz if self.gdim == 2 else None), strain
+
+    def _at_centres(self, expression, cells: np.ndarray) -> np.ndarray:
+        """A UFL expression evaluated at the centre of the given local cells, (cells, size)."""
         cell = self.V.mesh.ufl_cell().cellname()
         centre = {"triangle": [[1 / 3, 1 / 3]], "quadrilateral": [[0.5, 0.5]],
                   "tetrahedron": [[0.25, 0.25, 0.25]], "hexahedron": [[0.5, 0.5, 0.5]]}[cell]
-        expr = dolfinx.fem.Expression(sigma, np.array(centre, dtype=float))
+        expr = dolfinx.fem.Expression(expression, np.array(centre, dtype=float))
+        return expr.eval(np.asarray(cells, dtype=np.int32)).reshape(len(cells), -1)
+
+    def cell_stress(self) -> np.ndarray:
+        """Cauchy stress at the centre of every owned cell, (cells, gdim, gdim): σ = P Fᵀ / det F
+        at large rotations, the small-strain stress otherwise (non-existing cells: 0)."""
+        sigma = self._result_fields()[0]
+        if self.existing is not None:
+            sigma = self.existing * sigma
         owned = np.arange(self.V.mesh.topology.index_map(self.tdim).size_local, dtype=np.int32)
-        return expr.eval(owned).reshape(len(owned), self.gdim, self.gdim)
+        return self._at_centres(sigma, owned).reshape(len(owned), self.gdim, self.gdim)
+
+    @property
+    def section_components(self) -> tuple[str, ...]:
+        if self.gdim == 2:
+            return ("sxx", "syy", "szz", "sxy", "mises", "Exx", "Eyy", "Exy")
+        return ("sxx", "syy", "szz", "sxy", "syz", "sxz", "mises", "Exx", "Eyy", "Ezz", "Exy", "Eyz", "Exz")
+
+    def element_results(self, cells: np.ndarray | None = None, label: str = "",
+                        gather: bool = True) -> ElementResults:
+        """Stresses and strains at the centre of every (existing) cell, in global axes: the Cauchy
+        stress σ (in plane strain with σ_zz), its von Mises value √(3/2 s:s), and the
+        Green–Lagrange strain E = ½(FᵀF − I) — the small strain ε in a geometrically linear
+        analysis; tensor components (Exy = ½ γxy)."""
+        cells = self._result_cells(cells)
+        sigma, szz, strain = self._result_fields()
+        g = self.gdim
+        if g == 2:
+            full = ufl.as_matrix([[sigma[0, 0], sigma[0, 1], 0.0], [sigma[1, 0], sigma[1, 1], 0.0], [0.0, 0.0, szz]])
+            comps = [sigma[0, 0], sigma[1, 1], szz, sigma[0, 1]]
+            strains = [strain[0, 0], strain[1, 1], strain[0, 1]]
+        else:
+            full = sigma
+            comps = [sigma[0, 0], sigma[1, 1], sigma[2, 2], sigma[0, 1], sigma[1, 2], sigma[0, 2]]
+            strains = [strain[0, 0], strain[1, 1], strain[2, 2], strain[0, 1], strain[1, 2], strain[0, 2]]
+        dev = full - ufl.tr(full) / 3.0 * ufl.Identity(3)
+        mises = ufl.sqrt(1.5 * ufl.inner(dev, dev))
+        values = self._at_centres(ufl.as_vector(comps + [mises] + strains), cells)
+        x = ufl.SpatialCoordinate(self.V.mesh) + self.state
+        if self._shifted:
+            x = x + self.reference_shift
+        centres = self._at_centres(x, cells)
+        return self._gather_results("stresses", self.section_components, cells, centres[:, None, :],
+                                    values[:, None, :], None, label, gather)
 
     def held_blocks(self) -> np.ndarray:
         if self.existing is None:

@@ -31,8 +31,11 @@
 #
 # Checked: in every setting the soil's base reaction equals F (to 1e-8) and
 # the interface pressure on the footing's lower face (both passes of the
-# symmetric setting combined, `pair.pressure`) integrates to F (to 1e-6); no
-# step is cut; the settlement of the load point is the
+# symmetric setting combined, `pair.pressure`) integrates to F (to 1e-6); the
+# footing's bending moment at the load point (`scene.element_results(beam)`)
+# equals the moment of the contact forces on one half about it, in the
+# deformed geometry (to 1e-6; `footing_moments.png` draws the moment on the
+# side in tension, 111.9 at the load on the fine mesh); no step is cut; the settlement of the load point is the
 # same in the three settings (to 0.1 %) and converged in the mesh (soil
 # elements 1/8 and 1/16: to 0.2 %).
 #
@@ -91,7 +94,7 @@ def scene(h: float, setting: str):
         made = sc.contact(slaves=(beam, "footing"), masters=(soil, "top"), law=law)
     else:
         made = sc.contact(slaves=(beam, "footing"), masters=(soil, "top"), law=law, symmetric=True)
-    return sc, made
+    return sc, made, beam
 
 
 # %% [markdown]
@@ -114,12 +117,12 @@ def footing_side(setting: str) -> str:
 def runs(demo):
     """One row per mesh and setting (settlement, base reaction, Σ p L on the footing's face, cost)
     and the pressure profiles on that face."""
-    rows, profiles = [], {}
+    rows, profiles, moments = [], {}, {}
     for mesh_name, h in meshes.items():
         for setting in settings:
             if demo.ci and mesh_name == "fine" and setting != "symmetric":
                 continue
-            sc, made = scene(h, setting)
+            sc, made, beam = scene(h, setting)
             shots = None
             if (mesh_name, setting) == ("fine", "symmetric"):  # the pictures: the run made in every mode
                 shots = dc.plot.Snapshots(sc, at=(1 / 6, 1 / 3, 2 / 3, 1.0))
@@ -130,8 +133,18 @@ def runs(demo):
                    "base_Fy": float(hist.column("base_Fy")[-1]), "pressure_resultant": pressure,
                    "newton_iterations": int(hist.column("iterations").sum()), "cuts": int(hist.column("cuts").sum()),
                    "max_uzawa": int(hist.column("uzawa_updates").max()), "wall_s": wall}
+            # the footing's bending moment at the load point, and the moment about it of the contact
+            # forces on the footing's right half (half-footing equilibrium in the deformed geometry)
+            sections = sc.element_results(beam)
+            row["M_mid"] = sections.at((0.0, DEPTH / 2 - row["settlement"]))["M"]  # at its current place
+            on_face = made.pressure(footing_side(setting), current=True)
+            right = on_face.x[:, 0] > 1e-12
+            axis = on_face.x[right] - DEPTH / 2 * on_face.normal[right]  # the forces act through the nodes
+            arm = axis - np.array([0.0, DEPTH / 2 - row["settlement"]])  # from the load point
+            row["M_contact"] = float(np.sum(arm[:, 0] * on_face.force[right, 1] - arm[:, 1] * on_face.force[right, 0]))
             rows.append(row)
             profiles[(mesh_name, setting)] = made.pressure(footing_side(setting), current=True)
+            moments[(mesh_name, setting)] = sections
             if shots is not None:
                 for state in shots.states:
                     state.label = f"F = {F * state.load_factor:.0f}"
@@ -140,16 +153,25 @@ def runs(demo):
             demo.say(f"{mesh_name:6s} {setting:9s}: settlement {row['settlement']:.5f}, "
                      f"base reaction {row['base_Fy']:.8f}, "
                      f"Σ p L = {pressure:.6f}; {row['newton_iterations']} Newton its, {row['cuts']} cuts, "
-                     f"≤ {row['max_uzawa']} Uzawa updates per step, {wall:.1f} s")
-    return rows, profiles
+                     f"≤ {row['max_uzawa']} Uzawa updates per step, {wall:.1f} s; M at the load "
+                     f"{row['M_mid']:.3f} (contact forces' moment on a half {row['M_contact']:.3f})")
+    return rows, profiles, moments
 
 
 # %% [markdown]
 # ## Output: settlement table, pressure profiles (PNG)
 
 # %%
-def plot(demo, rows, profiles):
+def plot(demo, rows, profiles, moments):
     demo.table("settlement.csv", rows)
+    fig, ax = demo.figure(len(settings), 1, figsize=(7, 6.5), sharex=True)
+    for a, setting in zip(ax, settings):  # the footing's moment, drawn on the side in tension
+        mesh_name = "fine" if ("fine", setting) in moments else "coarse"
+        dc.plot.diagram(a, moments[(mesh_name, setting)], "M", scale=0.4 / max(r["M_mid"] for r in rows))
+        a.set(title=f"{setting}, {mesh_name} mesh: bending moment of the footing (tension side)", ylabel="y")
+        a.title.set_fontsize(9)
+    ax[-1].set_xlabel("x")
+    demo.save(fig, "footing_moments.png")
     fig, ax = demo.figure(figsize=(8, 4))
     for setting in settings:  # the finest mesh run in each setting
         mesh_name = "fine" if ("fine", setting) in profiles else "coarse"
@@ -171,12 +193,15 @@ def plot(demo, rows, profiles):
 # %%
 def main() -> dict:
     demo = Demo("beam_on_soil_2d")
-    rows, profiles = runs(demo)
-    plot(demo, rows, profiles)
+    rows, profiles, moments = runs(demo)
+    plot(demo, rows, profiles, moments)
     demo.check("base reaction, every run (the whole load passes through contact)", [r["base_Fy"] for r in rows], F,
                rtol=1e-8, reference="global equilibrium: the applied load F")
     demo.check("Σ p L on the footing's face, every run", [r["pressure_resultant"] for r in rows], F,
                rtol=1e-6, reference="global equilibrium: the applied load F")
+    demo.check("footing's moment at the load point / moment of the contact forces on one half about it, every run",
+               [r["M_mid"] / r["M_contact"] for r in rows], 1.0, rtol=1e-6,
+               reference="equilibrium of the half footing (section moment: scene.element_results)")
     demo.check("failed load steps, every run", [r["cuts"] for r in rows], 0,
                reference="solver acceptance (no published value)")
     demo.check("most Uzawa updates in a step, every run", [r["max_uzawa"] for r in rows], bound=5,

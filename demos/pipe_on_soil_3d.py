@@ -152,7 +152,8 @@ def run(h: float, steps: int = 20, large: bool = True, shots_at: tuple | None = 
             "axis_settlement_mid": float(axis.values[pressed][len(axis.X) // 2, 2]),
             "betti_error": float(np.abs(settlement / (weight * BETTI) - 1.0).max()),
             "mean_settlement": settlement, "weight": weight,
-            "history": history, "axis": axis, "surface_end": top_now, **({} if shots is None else {"shots": shots})}
+            "history": history, "axis": axis, "surface_end": top_now, "sections": sc.element_results(pipe),
+            **({} if shots is None else {"shots": shots})}
 
 
 def picture(demo, h: float, shots) -> None:
@@ -170,7 +171,9 @@ def picture(demo, h: float, shots) -> None:
 # `pipe_on_soil_3d_shapes.png` shows the run on h = 0.2 with the weight pressed in, then the
 # pipe dragged by 0.25 and 0.5 (true scale, the undeformed pipe in grey; colours up to 1.5 cm,
 # the dragged pipe is off the scale): the trough its weight digs in the block's top, which
-# follows the pipe along.
+# follows the pipe along. `pipe_on_soil_3d_forces.png` draws the pipe's bending moment in its
+# vertical plane and its normal force along it at the end of the drag
+# (`scene.element_results(pipe)`, `dc.plot.diagram`).
 
 # %%
 def main() -> dict:
@@ -224,6 +227,14 @@ def main() -> dict:
                 title="the top's mean settlement")
     axes[2].legend(fontsize=7)
     demo.save(fig, "pipe_on_soil_3d.png")
+    # the pipe's section forces at the end (its axis in the plane x–z: e2 = z, so its bending in that
+    # plane is Mz, drawn along e2 on the side in tension; the normal force along e2 too)
+    fig, axes = demo.figure(2, 1, figsize=(11, 5.0))
+    for ax, component, name in zip(axes, ("Mz", "N"), ("bending moment Mz", "normal force N")):
+        dc.plot.diagram(ax, finest["sections"], component, plane=(0, 2))
+        ax.set(title=f"the pipe's {name} at the end of the drag (h = {finest['h']:g})", xlabel="x", ylabel="z")
+        ax.title.set_fontsize(9)
+    demo.save(fig, "pipe_on_soil_3d_forces.png")
     hist = finest["history"]
     demo.record(load_factor=hist.column("load_factor"), contact_Fz=hist.column("contact_Fz"),
                 axis_mid_uz=[v[len(axis.X) // 2, 2] for v in axis.values])

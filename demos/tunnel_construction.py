@@ -45,7 +45,7 @@ import numpy as np
 
 import dolfinx_corot as dc
 from dolfinx_corot.gallery import Demo
-from frame_filling_1 import build, draw_stages, picture_stages, run, verify_common
+from frame_filling_1 import build, draw_moments, draw_stages, picture_stages, run, verify_common
 
 GEOMETRY = dict(width=18.0, height=12.0, pit_width=12.0, pit_depth=6.0, span=6.0, rise=3.5, thickness=0.3)
 GROUND = dict(E=5e6, nu=0.3, rho=2000.0)
@@ -80,6 +80,8 @@ def heave(snapshot, x, y) -> float:
 # `tunnel_stages.png` pictures approach II at the end of each stage after the geostatic one:
 # the pit's floor heaving by 11 cm, then the lining and the ground settling as the seven layers
 # are placed (displacements × 5, coloured by their magnitude; the undeformed shape in grey).
+# `tunnel_moments.png` draws the lining's bending moment on the side in tension (per metre of
+# tunnel, `dc.plot.diagram`) after the lining's stage, halfway and after the last layer.
 
 # %%
 def plot(demo, out, setup, stopped) -> None:
@@ -124,6 +126,7 @@ def main() -> dict:
     draw_stages(demo, out, scale=5.0)
     picture_stages(demo, out["shots"], "tunnel_stages.png", "II", scale=5.0, names={"frame": "lining"}, columns=3,
                    window_size=(1800, 1500))
+    draw_moments(demo, out, "tunnel_moments.png")
     g = GEOMETRY
     y_floor = g["height"] - g["pit_depth"]
     lifted = heave(out["snapshots"]["excavation"], 0.0, y_floor)

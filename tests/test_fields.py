@@ -1,4 +1,6 @@
 """FieldWriter on every part kind: the XDMF file read back with meshio holds the computed values."""
+import re
+
 import numpy as np
 import pytest
 from mpi4py import MPI
@@ -158,3 +160,34 @@ def test_field_writer_writes_one_file_per_mesh_of_a_coupled_scene(tmp_path):
         dc.solve(sc, dc.LoadControl(steps=1), on_step=writer)
     for i, model in enumerate(sc.model.models):
         _check_file(path.replace(".xdmf", f"_{i}.xdmf"), model)
+
+
+def test_field_writer_writes_the_interface_pressure_at_the_nodes_of_each_side(tmp_path):
+    """Two blocks pressed together by a uniform stress P (the two-pass patch test of
+    test_contact_pressure.py): the contact pressure written at the nodes of both interface sides is P
+    (to the Newton tolerance), 0 at every other node."""
+    P = 0.01
+    tm = rectangles({"lower": (0.0, 0.0, 1.0, 1.0, 3, 2), "upper": (0.0, 1.0, 1.0, 1.0, 4, 2)},
+                    {"base": [("lower", "bottom")], "lower_top": [("lower", "top")],
+                     "upper_bottom": [("upper", "bottom")], "top": [("upper", "top")],
+                     "left": [("lower", "left"), ("upper", "left")]}, comm=comm)
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(1.0, 0.3), degree=1)
+    sc.fix(b, "base", dofs=("uy",))
+    sc.fix(b, "left", dofs=("ux",))
+    sc.load(b, "top", traction=(0.0, -P))
+    pair = sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), symmetric=True, smooth=False,
+                      law=dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4))
+    path = comm.bcast(str(tmp_path / "contact.xdmf") if comm.rank == 0 else None, root=0)
+    with dc.io.FieldWriter(sc, path, contacts=[pair]) as writer:
+        dc.solve(sc, dc.LoadControl(steps=1), on_step=writer)
+    X, _ = b.model.nodes()
+    if comm.rank != 0:
+        return
+    _, points, data = _read_xdmf(path)
+    on = np.isclose(points[:, 1], 1.0)  # the upper block's 5 nodes there and the lower one's 4
+    assert on.sum() == 9
+    for side, nodes in (("slaves", 5), ("masters", 4)):
+        p = data[re.sub(r"\W+", "_", f"contact_{pair.name}_{side}")].ravel()
+        assert np.sum(np.abs(p[on] / P - 1.0) < 1e-7) == nodes  # the side's nodes: P; the other's: 0
+        assert np.sum(np.abs(p[on]) < 1e-12 * P) == 9 - nodes and np.all(np.abs(p[~on]) < 1e-12 * P)

@@ -31,34 +31,40 @@ def check_props(E: float, nu: float, t: float, label: str) -> None:
 
 
 @numba.njit(cache=True)
+def strain_B(xy, xi, eta, B):
+    """Fill B (3, 8), the strain matrix ε = (ε_xx, ε_yy, γ_xy) = B d̄ of the Q4 at (ξ, η), for the
+    local node coordinates xy (4, 2), counter-clockwise; returns det J."""
+    dN = np.empty((2, 4))
+    for a in range(4):
+        dN[0, a] = 0.25 * _NODES[a, 0] * (1.0 + _NODES[a, 1] * eta)
+        dN[1, a] = 0.25 * _NODES[a, 1] * (1.0 + _NODES[a, 0] * xi)
+    J00 = J01 = J10 = J11 = 0.0
+    for a in range(4):
+        J00 += dN[0, a] * xy[a, 0]
+        J01 += dN[0, a] * xy[a, 1]
+        J10 += dN[1, a] * xy[a, 0]
+        J11 += dN[1, a] * xy[a, 1]
+    det = J00 * J11 - J01 * J10
+    for a in range(4):
+        nx = (J11 * dN[0, a] - J01 * dN[1, a]) / det
+        ny = (-J10 * dN[0, a] + J00 * dN[1, a]) / det
+        B[0, 2 * a] = nx
+        B[1, 2 * a + 1] = ny
+        B[2, 2 * a] = ny
+        B[2, 2 * a + 1] = nx
+    return det
+
+
+@numba.njit(cache=True)
 def local_stiffness(xy, props, K):
     """K (8, 8) for the local node coordinates xy (4, 2), counter-clockwise."""
     E, nu, t = props[E_], props[NU], props[T]
     c = E / (1.0 - nu * nu)
     D = np.array([[c, c * nu, 0.0], [c * nu, c, 0.0], [0.0, 0.0, c * (1.0 - nu) / 2.0]])
     K[:, :] = 0.0
-    dN = np.empty((2, 4))
     B = np.zeros((3, 8))
     for q in range(4):
-        xi, eta = _GAUSS[q, 0], _GAUSS[q, 1]
-        for a in range(4):
-            dN[0, a] = 0.25 * _NODES[a, 0] * (1.0 + _NODES[a, 1] * eta)
-            dN[1, a] = 0.25 * _NODES[a, 1] * (1.0 + _NODES[a, 0] * xi)
-        J00 = J01 = J10 = J11 = 0.0
-        for a in range(4):
-            J00 += dN[0, a] * xy[a, 0]
-            J01 += dN[0, a] * xy[a, 1]
-            J10 += dN[1, a] * xy[a, 0]
-            J11 += dN[1, a] * xy[a, 1]
-        det = J00 * J11 - J01 * J10
-        for a in range(4):
-            nx = (J11 * dN[0, a] - J01 * dN[1, a]) / det
-            ny = (-J10 * dN[0, a] + J00 * dN[1, a]) / det
-            B[0, 2 * a] = nx
-            B[1, 2 * a + 1] = ny
-            B[2, 2 * a] = ny
-            B[2, 2 * a + 1] = nx
-        w = t * det
+        w = t * strain_B(xy, _GAUSS[q, 0], _GAUSS[q, 1], B)
         for i in range(8):
             for j in range(8):
                 acc = 0.0
@@ -69,25 +75,7 @@ def local_stiffness(xy, props, K):
 
 @numba.njit(cache=True)
 def centre_B(xy):
-    """The strain matrix (3, 8) of the Q4 at its centre (ξ = η = 0) for the local node
-    coordinates xy (4, 2), counter-clockwise: ε = (ε_xx, ε_yy, γ_xy) = B d̄."""
-    dN = np.empty((2, 4))
-    for a in range(4):
-        dN[0, a] = 0.25 * _NODES[a, 0]
-        dN[1, a] = 0.25 * _NODES[a, 1]
-    J00 = J01 = J10 = J11 = 0.0
-    for a in range(4):
-        J00 += dN[0, a] * xy[a, 0]
-        J01 += dN[0, a] * xy[a, 1]
-        J10 += dN[1, a] * xy[a, 0]
-        J11 += dN[1, a] * xy[a, 1]
-    det = J00 * J11 - J01 * J10
+    """The strain matrix (3, 8) of the Q4 at its centre (ξ = η = 0) (see :func:`strain_B`)."""
     B = np.zeros((3, 8))
-    for a in range(4):
-        nx = (J11 * dN[0, a] - J01 * dN[1, a]) / det
-        ny = (-J10 * dN[0, a] + J00 * dN[1, a]) / det
-        B[0, 2 * a] = nx
-        B[1, 2 * a + 1] = ny
-        B[2, 2 * a] = ny
-        B[2, 2 * a + 1] = nx
+    strain_B(xy, 0.0, 0.0, B)
     return B

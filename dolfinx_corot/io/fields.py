@@ -2,6 +2,9 @@
 from __future__ import annotations
 
 import os
+import re
+
+import numpy as np
 
 import dolfinx.fem
 import dolfinx.io
@@ -21,18 +24,23 @@ class FieldWriter:
     component, named by it: a beam's section forces N, V, M (3D: N, Vy, Vz, T, My, Mz) as the mean
     of its two ends, a shell's or membrane's resultants and face stresses, a solid's Cauchy stress,
     von Mises stress and Green–Lagrange strain at the cell's centre; cells that do not exist carry
-    0. Close it (or use it in a ``with`` block) to flush the file.
+    0. ``contacts``: contact pairs (what ``Scene.contact`` returned) whose interface pressure
+    (:meth:`~dolfinx_corot.ContactPair.pressure`: nominal, both passes combined, ≥ 0 in
+    compression) is written at the nodes of each side, ``contact_<pair>_slaves`` and
+    ``contact_<pair>_masters`` on the part that side belongs to (0 off the interface).
+    Close it (or use it in a ``with`` block) to flush the file.
     A scene whose parts live on several meshes writes one file per mesh,
     ``path`` with ``_0``, ``_1``, … before the extension.
     """
 
-    def __init__(self, scene, path: str, model=None, results: bool = True):
+    def __init__(self, scene, path: str, model=None, results: bool = True, contacts=()):
         model = scene.model if model is None else model
         self.parts = []
         self.path = path
         if model.coupled:
             stem, ext = os.path.splitext(path)
-            self.parts = [FieldWriter(scene, f"{stem}_{i}{ext}", m, results) for i, m in enumerate(model.models)]
+            self.parts = [FieldWriter(scene, f"{stem}_{i}{ext}", m, results, contacts)
+                          for i, m in enumerate(model.models)]
             return
         mesh = model.V.mesh
         self.model = model
@@ -42,6 +50,19 @@ class FieldWriter:
         if results and getattr(model, "section_components", ()):
             dg0 = dolfinx.fem.FunctionSpace(mesh, ("DG", 0))
             self.cell_fields = {c: dolfinx.fem.Function(dg0, name=c) for c in model.section_components}
+        # (pair, side, its surface, a scalar function on the part's nodes, its dof of each node, one at P1)
+        self.pressures = []
+        for pair in contacts:
+            for side in ("slaves", "masters"):
+                first = pair.interfaces[0]
+                surface = first.slave if side == "slaves" else first.master
+                if surface.part is model:
+                    name = re.sub(r"\W+", "_", f"contact_{pair.name}_{side}")
+                    scalar, parent = model.V.sub(0).collapse()  # parent: the V dof of each scalar dof
+                    at_block = np.empty(len(parent), dtype=np.int32)
+                    at_block[np.asarray(parent) // model.V.dofmap.index_map_bs] = np.arange(len(parent))
+                    shown = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1)), name=name)
+                    self.pressures.append((pair, side, surface, dolfinx.fem.Function(scalar), at_block, shown))
         self.file = dolfinx.io.XDMFFile(mesh.comm, path, "w")
         self.file.write_mesh(mesh)
 
@@ -63,6 +84,12 @@ class FieldWriter:
                 f.x.array[f.function_space.dofmap.list.array[local.cells]] = local.values[:, :, k].mean(axis=1)
                 f.x.scatter_forward()
                 self.file.write_function(f, t)
+        for pair, side, surface, nodal, at_block, shown in self.pressures:
+            nodal.x.array[:] = 0.0
+            nodal.x.array[at_block[surface.blocks]] = pair.pressure(side).pressure[surface.local]
+            nodal.x.scatter_forward()
+            shown.interpolate(nodal)
+            self.file.write_function(shown, t)
 
     def close(self) -> None:
         for part in self.parts:

@@ -95,13 +95,21 @@ def linear(X, u, R0, xbar0, Kbar, f, K):
 
 
 @numba.njit(cache=True)
-def evaluate(X, S, props, large_rotations, f24, K24):
-    """Element vector f24 (24,) and matrix K24 (24, 24) in DOLFINx vertex order and dof layout."""
+def _counter_clockwise(X, S):
+    """(positions (4, 3), displacements (4, 3)) of the nodes counter-clockwise, from DOLFINx's
+    vertex order."""
     Xc = np.empty((4, 3))
     u = np.empty((4, 3))
     for a in range(4):
         Xc[a] = X[CCW[a]]
         u[a] = S[CCW[a], :3]
+    return Xc, u
+
+
+@numba.njit(cache=True)
+def evaluate(X, S, props, large_rotations, f24, K24):
+    """Element vector f24 (24,) and matrix K24 (24, 24) in DOLFINx vertex order and dof layout."""
+    Xc, u = _counter_clockwise(X, S)
     edata = np.empty(NEDATA)
     element_data(Xc, props, edata)
     _evaluate_ccw(Xc, u, edata, large_rotations, True, f24, K24)
@@ -138,11 +146,7 @@ def resultants(X, S, props, large_rotations, out, axes):
     initial one for a geometrically linear analysis): membrane forces N = t D ε̄(0, 0), the
     stress N/t on both faces and its von Mises value; no moments or shears. axes (3, 3): rows
     e1, e2, e3."""
-    Xc = np.empty((4, 3))
-    u = np.empty((4, 3))
-    for a in range(4):
-        Xc[a] = X[CCW[a]]
-        u[a] = S[CCW[a], :3]
+    Xc, u = _counter_clockwise(X, S)
     edata = np.empty(NEDATA)
     element_data(Xc, props, edata)
     R0, xbar0, _ = unpack_constants(edata, 4, 8)

@@ -39,6 +39,7 @@ notebooks: setup-docs
 	$(PY) scripts/notebooks.py
 
 bench: setup
+	$(PY) benchmarks/startup.py                    # import and a small model's whole process, against import dolfinx
 	$(PY) benchmarks/beam2d.py
 	$(PY) benchmarks/pullout.py
 	$(PY) benchmarks/frame3d.py --sizes 7 15 32   # 10³, 10⁴, 10⁵ elements: about 20 minutes

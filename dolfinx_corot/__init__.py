@@ -3,7 +3,14 @@
 The user's model is a :class:`Scene`; a driver (:class:`LoadControl`)
 follows the load path; :func:`solve` returns a :class:`Result` with the
 per-step history.
+
+Importing the package does no work: each name below is imported when it is first used
+(``dc.Scene`` brings DOLFINx and the scene's modules, a part's element kernels come with the
+first part of their kind, gmsh with the first gmsh model read, PyVista with the first picture).
 """
+from __future__ import annotations
+
+import importlib as _importlib
 import os as _os
 
 # one thread per MPI rank: a threaded BLAS/OpenMP runtime spins idle threads that take the
@@ -11,33 +18,45 @@ import os as _os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
     _os.environ.setdefault(_var, "1")
 
-try:  # VTK's C++ runtime before numba's: llvmlite's exported std::string symbols otherwise take
-    import vtkmodules.vtkCommonCore  # noqa: F401,E402  (over VTK's and crash its std::regex: pictures)
-except ImportError:  # no PyVista: no pictures
-    pass
-
-from .console import announce_compilation, show_compiler_output  # noqa: E402
+from .console import show_compiler_output  # noqa: E402
 
 show_compiler_output(_os.environ.get("DC_COMPILER_OUTPUT", "") not in ("", "0"))
-announce_compilation()
-
-from . import plot, rotations  # noqa: E402
-from .amplitudes import Amplitude
-from .contact.laws import AugmentedLagrangian, ContactError, Coulomb, Penalty
-from .contact.pair import ContactPair
-from .io.mesh import GroupNotFoundError, TaggedMesh, from_gmsh
-from .materials import Elastic, NeoHookean, SaintVenantKirchhoff
-from .parts import MeshError
-from .result import History, Result
-from .scene import Scene
-from .sections import Circle, Pipe, Rectangle, Section
-from .solvers import (ArcLength, CheckpointError, ConvergenceError, CriticalPoint, CriticalPointError, LoadControl,
-                      NewtonOptions, SingularModelError, solve)
 
 __version__ = "0.1.0"
 
-__all__ = ["Amplitude", "ArcLength", "AugmentedLagrangian", "CheckpointError", "ContactError", "ContactPair",
-           "Coulomb", "Penalty", "Circle", "ConvergenceError", "CriticalPoint", "CriticalPointError",
-           "SingularModelError", "Elastic", "show_compiler_output", "GroupNotFoundError", "History", "LoadControl", "MeshError", "NeoHookean",
-           "NewtonOptions", "Pipe", "Rectangle", "SaintVenantKirchhoff", "Result", "Scene", "Section", "TaggedMesh",
-           "from_gmsh", "plot", "rotations", "solve"]
+#: public name → the module that defines it
+_WHERE = {
+    "Amplitude": "amplitudes",
+    "AugmentedLagrangian": "contact.laws", "ContactError": "contact.laws", "Coulomb": "contact.laws",
+    "Penalty": "contact.laws",
+    "ContactPair": "contact.pair",
+    "GroupNotFoundError": "io.mesh", "TaggedMesh": "io.mesh", "from_gmsh": "io.mesh",
+    "Elastic": "materials", "NeoHookean": "materials", "SaintVenantKirchhoff": "materials",
+    "MeshError": "parts",
+    "History": "result", "Result": "result",
+    "Scene": "scene",
+    "Circle": "sections", "Pipe": "sections", "Rectangle": "sections", "Section": "sections",
+    "ArcLength": "solvers", "CheckpointError": "solvers", "ConvergenceError": "solvers",
+    "CriticalPoint": "solvers", "CriticalPointError": "solvers", "LoadControl": "solvers",
+    "NewtonOptions": "solvers", "SingularModelError": "solvers", "solve": "solvers",
+}
+#: subpackages and modules reachable as attributes (``dc.plot``, ``dc.io``, …)
+_MODULES = ("amplitudes", "closed_forms", "contact", "gallery", "io", "materials", "plot", "result", "rotations",
+            "scene", "sections", "solvers", "staging")
+
+__all__ = sorted(_WHERE) + ["plot", "rotations", "show_compiler_output"]
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        value = getattr(_importlib.import_module(f".{_WHERE[name]}", __name__), name)
+    elif name in _MODULES:
+        value = _importlib.import_module(f".{name}", __name__)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value  # once imported, an ordinary attribute
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_WHERE) | set(_MODULES))

@@ -7,8 +7,9 @@ first compilation.
   unless asked for: :func:`show_compiler_output` (or ``DC_COMPILER_OUTPUT=1`` in the
   environment) lets them through. Warnings and errors of the compilers always pass.
 - The element kernels are numba functions compiled once and cached on disk beside the
-  package's sources; the first import of a fresh installation compiles them (about 40 s on one
-  core). :func:`announce_compilation` says so on standard output (rank 0) before it starts.
+  package's sources; the first part of a kind in a fresh installation compiles its kernels
+  (10–20 s a kind on one core; the set-up compiles them all). :func:`announce_compilation` says
+  so on standard output (rank 0) before it starts.
 """
 from __future__ import annotations
 
@@ -45,26 +46,27 @@ def show_compiler_output(show: bool = True) -> None:
         root.addFilter(_FILTER)
 
 
-def kernels_cached() -> bool:
-    """Whether numba's cache of the element kernels exists (beside the sources, or under
-    ``$NUMBA_CACHE_DIR``)."""
-    here = glob.glob(os.path.join(_PACKAGE, "kernels", "__pycache__", "*.nbi"))
-    if here:
+def kernels_cached(kind: str = "*") -> bool:
+    """Whether numba's cache of the element kernels of ``kind`` (a module of
+    :mod:`dolfinx_corot.kernels`: 'beam3d', 'line2d', 'shell3d', 'membrane_quad'; '*': any) exists,
+    beside the sources or under ``$NUMBA_CACHE_DIR``."""
+    name = f"{kind}.vector_kernel_tabulate_*.nbi"
+    if glob.glob(os.path.join(_PACKAGE, "kernels", "__pycache__", name)):
         return True
     cache = os.environ.get("NUMBA_CACHE_DIR")
-    return bool(cache) and bool(glob.glob(os.path.join(cache, "**", "*dolfinx_corot*", "**", "*.nbi"),
-                                          recursive=True))
+    return bool(cache) and bool(glob.glob(os.path.join(cache, "**", "*dolfinx_corot*", "**", name), recursive=True))
 
 
-def announce_compilation(stream=None) -> bool:
-    """Say on standard output (rank 0 of ``MPI.COMM_WORLD``) that the kernels are about to be
-    compiled, when their cache is empty; returns whether it was."""
-    if kernels_cached():
+def announce_compilation(kind: str = "*", stream=None) -> bool:
+    """Say on standard output (rank 0 of ``MPI.COMM_WORLD``) that the element kernels of ``kind``
+    are about to be compiled, when their cache is empty; returns whether it was."""
+    if kernels_cached(kind):
         return False
     from mpi4py import MPI
 
     if MPI.COMM_WORLD.rank == 0:
         out = sys.stdout if stream is None else stream
-        out.write("dolfinx_corot: compiling the element kernels, once: about 40 s\n")
+        what = "the element kernels" if kind == "*" else f"the {kind} element kernels"
+        out.write(f"dolfinx_corot: compiling {what}, once: about 20 s\n")
         out.flush()
     return True

@@ -23,10 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .conditions import Condition
-from .contact.interface import Contact, Interface
-from .contact.interface3d import Interface3D
 from .contact.laws import ContactError, Penalty
-from .contact.mortar import MortarInterface3D
 from .contact.pair import ContactPair
 from .io.mesh import TaggedMesh
 from .loads import FollowerLoads
@@ -402,6 +399,10 @@ class Scene:
         (one, or two when symmetric), which gives the interface pressure of both passes combined
         on either side's contact face (``pair.pressure(on="slaves")``, a beam's face at half its
         depth) and its resultant; see also :meth:`monitor_contact`."""
+        from .contact.interface import Interface  # (a scene without contact loads no contact modules)
+        from .contact.interface3d import Interface3D
+        from .contact.mortar import MortarInterface3D
+
         law = Penalty() if law is None else law
         if discretization not in ("node_to_face", "mortar"):
             raise ValueError(f"contact: discretization = {discretization!r} must be 'node_to_face' or 'mortar'")
@@ -597,7 +598,11 @@ class Scene:
     def contributions(self) -> list:
         """The contributions the scene adds to its parts' system (contact, when it has interfaces;
         the stabilisation, when a part is stabilised): a scene without them pays nothing for them."""
-        out = [Contact(self.interfaces)] if self.interfaces else []
+        out = []
+        if self.interfaces:
+            from .contact.interface import Contact
+
+            out.append(Contact(self.interfaces))
         if self.stabilisers:
             out.append(Stabilisation(self.stabilisers))
         followers = [f for m in self._models.values() for f in m.followers]

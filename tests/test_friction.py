@@ -188,7 +188,8 @@ def test_a_restart_in_the_middle_of_sliding_is_exact(tmp_path, augmented):
     """Killed at step 10 (partial slip: the stick points of the sticking and of the slipping slaves
     are history) and restarted from the checkpoint of step 9: iterations, Uzawa updates and the
     reactions of every step are the uninterrupted run's, the stick points and the tangential
-    multipliers too (1e-10); with the shear augmented as well."""
+    multipliers too (1e-10; on two ranks 1e-8 and ±1 iteration: the parallel solver's run-to-run
+    round-off); with the shear augmented as well."""
     def kill(row):
         if row["step"] == 10:
             raise _Killed
@@ -202,14 +203,18 @@ def test_a_restart_in_the_middle_of_sliding_is_exact(tmp_path, augmented):
         dc.solve(_block_on_base(law), driver, checkpoint=path, on_step=kill)
     resumed_scene = _block_on_base(law)
     resumed = dc.solve(resumed_scene, driver, restart=path).history
+    # two ranks: the parallel solver's round-off differs from run to run (the killed run's steps
+    # may take an iteration more or less than the full run's, as in test_friction3d.py)
+    serial = comm.size == 1
+    tol = 1e-10 if serial else 1e-8
     for col in ("iterations", "uzawa_updates", "cuts"):
-        np.testing.assert_array_equal(resumed.column(col), full.column(col), err_msg=col)
+        np.testing.assert_allclose(resumed.column(col), full.column(col), atol=0 if serial else 1, err_msg=col)
     for col in ("top_Fx", "top_Fy"):
         F = full.column(col)  # (atol: the round-off of the forces before the push)
-        np.testing.assert_allclose(resumed.column(col), F, rtol=1e-10, atol=1e-10 * np.abs(F).max(), err_msg=col)
+        np.testing.assert_allclose(resumed.column(col), F, rtol=tol, atol=tol * np.abs(F).max(), err_msg=col)
     a, b = full_scene.interfaces[0], resumed_scene.interfaces[0]
     assert (a.stick_segment >= 0).sum() > 0
     np.testing.assert_array_equal(a.stick_segment, b.stick_segment)
-    np.testing.assert_allclose(a.stick_xi, b.stick_xi, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(a.stick_xi, b.stick_xi, rtol=tol, atol=0.01 * tol)
     assert np.abs(a.stick_lambda).max() > 0.0
-    np.testing.assert_allclose(a.stick_lambda, b.stick_lambda, rtol=1e-10, atol=1e-10 * np.abs(a.stick_lambda).max())
+    np.testing.assert_allclose(a.stick_lambda, b.stick_lambda, rtol=tol, atol=tol * np.abs(a.stick_lambda).max())

@@ -83,9 +83,11 @@ def test_a_load_reversal_unloads_elastically_then_slides_back_at_mu(hard_case):
     again, at once, from the elastic predictor (every slave sticks in its first evaluation),
     from which Newton converges in 4 iterations; the step's 10 Uzawa updates of the pressure
     (gap_tolerance 1e-8) and their re-solves bring it to 32 (6–26 in the other steps). Without
-    that second start the step was cut twice. On two ranks the first start sometimes converges
-    within its 25 iterations and sometimes not (the parallel solver's round-off differs from run
-    to run; 48 iterations with the second start)."""
+    that second start the step was cut twice. The first start is marginal: on two ranks it
+    sometimes converges within its 25 iterations and sometimes not (the parallel solver's
+    round-off differs from run to run; 48 iterations with the second start), and a serial run
+    whose contact kernels were just compiled once converged without it; the second start, where
+    it is needed, is taken in that step only."""
     tm = _slider_3d(False)
     push = dc.Amplitude(((0.0, 0.0), (1 / STEPS, 0.0), (7 / STEPS, 1.0), (1.0, -1.0)))
     law = dc.Coulomb(mu=0.3, tangential_factor=20.0)
@@ -96,7 +98,7 @@ def test_a_load_reversal_unloads_elastically_then_slides_back_at_mu(hard_case):
     iterations = h.column("iterations")
     assert h.column("cuts").sum() == 0 and iterations.max() <= 60, iterations
     restarts = np.flatnonzero(h.column("elastic_restarts"))
-    assert list(restarts) == [7] if comm.size == 1 else set(restarts) <= {7}, restarts
+    assert set(restarts) <= {7}, restarts
     ratio = np.hypot(Fx, Fy) / -Fz
     assert abs(ratio[6] / 0.3 - 1.0) < 1e-6 and Fx[6] * SHIFT[0] > 0.0, ratio  # forwards, at the end of the push
     for col, F in (("top_Fx", Fx), ("top_Fy", Fy)):  # the first step back: elastic

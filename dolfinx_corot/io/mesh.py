@@ -23,7 +23,6 @@ import numpy as np
 from mpi4py import MPI
 
 import dolfinx.mesh
-from dolfinx.io import gmshio
 
 
 class GroupNotFoundError(KeyError):
@@ -321,6 +320,8 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
     top = max(d for d, _ in groups.values())
     facet_tags = None
     if tdim == top:
+        from dolfinx.io import gmshio  # (gmsh is imported when a gmsh model is read)
+
         msh, cell_tags, facet_tags = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
     else:
         msh, cell_tags = _lower_dimensional_mesh(model, comm, rank, gdim, tdim)

@@ -19,6 +19,7 @@ import numpy as np
 from ..corotation import frame_quad as frame
 from ..corotation.transform import linear_force, positions, stiffness
 from ..elements import membrane_quad as law
+from . import CCW
 from .spatial import H, pack_constants, unpack_constants
 from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
@@ -27,7 +28,6 @@ NDOF = 6 * NNODE
 NSTATE = 7
 NEDATA = 9 + 12 + 64           # R0, x̄0, K̄ (computed once per cell)
 NCOEF = NNODE * NSTATE + law.NPROPS + NEDATA
-CCW = np.array([0, 1, 3, 2])   # DOLFINx vertex order → counter-clockwise
 _P0 = NNODE * NSTATE
 _E0 = _P0 + law.NPROPS
 

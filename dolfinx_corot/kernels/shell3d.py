@@ -32,6 +32,7 @@ from ..corotation.transform import linear_force, stiffness
 from ..elements import shell_triangle as law
 from .spatial import (H, last_node_columns, nodal_states, pack_constants, perturb, rotation_vector_dofs,
                       since_activation, unpack_constants)
+from . import RESULTANTS  # the names of resultants()' components
 from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
 NDOF = 18
@@ -155,11 +156,6 @@ def evaluate(X, S, props, large_rotations, f, K):
     edata = np.empty(NEDATA)
     element_data(X, props, edata)
     evaluate_cached(X, S, props, edata, large_rotations, f, K)
-
-
-#: the components of :func:`resultants`
-RESULTANTS = ("Nxx", "Nyy", "Nxy", "Mxx", "Myy", "Mxy", "Qx", "Qy", "sxx_top", "syy_top", "sxy_top",
-              "sxx_bottom", "syy_bottom", "sxy_bottom", "mises_top", "mises_bottom")
 
 
 @numba.njit(cache=True)

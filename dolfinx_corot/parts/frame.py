@@ -29,9 +29,7 @@ from ..elements import follower as follower_kernels
 from ..elements import uniform_load
 from ..io.mesh import TaggedMesh
 from ..loads import FollowerLoad
-from ..kernels import beam3d as kernels3d
-from ..kernels import line2d as kernels2d
-from ..kernels.spatial import since_activation_all
+from ..kernels import NSTATE, OnFirstUse
 from ..result import ElementResults
 from .base import AdditiveState, Part, PartRef
 from .cells import MeshError, check_geometry_degree, mesh_extent, refuse
@@ -384,6 +382,8 @@ class LineFrame(Part):
         if self._staged_shift():
             A = self._activations(cells)
             if self.state_size == 7:  # multiplicative rotations
+                from ..kernels.spatial import since_activation_all  # (loaded with the first kernels)
+
                 Xa, Sa = np.empty_like(X), np.empty_like(S)
                 since_activation_all(X, S, A, Xa, Sa)
                 return Xa, Sa
@@ -476,7 +476,7 @@ class Frame2D(AdditiveState, LineFrame):
     translations = 2
     state_size = 3
     nprops = law2d.NPROPS
-    kernels = kernels2d
+    kernels = OnFirstUse("line2d")
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
         super().__init__(tmesh, large_rotations)
@@ -573,22 +573,22 @@ def _update_quaternions(state, dx, n):
 class Rotations3D:
     """Nodal state (u, q) with multiplicative rotation updates, shared by 3D frames and surfaces."""
 
-    state_size = kernels3d.NSTATE
+    state_size = NSTATE
 
     def _init_state(self) -> None:
-        S = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("Lagrange", 1), dim=kernels3d.NSTATE)
+        S = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("Lagrange", 1), dim=NSTATE)
         self.state = dolfinx.fem.Function(S, name="state")
         self._reset_state()
         self._disp = dolfinx.fem.Function(self.V, name="displacement")
 
     def _reset_state(self) -> None:
         self.state.x.array[:] = 0.0
-        self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, 3] = 1.0  # identity rotations
+        self.state.x.array.reshape(-1, NSTATE)[:, 3] = 1.0  # identity rotations
 
     def update(self, dx: PETSc.Vec) -> None:
         """u ← u + du; q ← exp(dw)∘q (multiplicative, spatial) on owned nodes; ghosts from their owners."""
         n_owned = self.V.dofmap.index_map.size_local
-        st = self.state.x.array.reshape(-1, kernels3d.NSTATE)
+        st = self.state.x.array.reshape(-1, NSTATE)
         _update_quaternions(st, dx.array_r.reshape(-1, 6), n_owned)
         self.state.x.scatter_forward()
 
@@ -599,7 +599,7 @@ class Rotations3D:
     def displacement_vector(self) -> PETSc.Vec:
         """Displacements in the layout of the corrections (rotational entries 0), for constraints."""
         arr = self._disp.x.array.reshape(-1, 6)
-        arr[:, :3] = self.state.x.array.reshape(-1, kernels3d.NSTATE)[:, :3]
+        arr[:, :3] = self.state.x.array.reshape(-1, NSTATE)[:, :3]
         return self._disp.vector
 
     @staticmethod
@@ -608,7 +608,7 @@ class Rotations3D:
 
     def _rotation_values(self) -> np.ndarray:
         """Rotation vectors (blocks, 3) of the nodal quaternions (norm ≤ π)."""
-        st = self.state.x.array.reshape(-1, kernels3d.NSTATE)
+        st = self.state.x.array.reshape(-1, NSTATE)
         return rotations.rotvecs_from_quats(np.ascontiguousarray(st[:, 3:7]))
 
     def prescribe(self, where: str, comp: int, value: float, amplitude=None, function=None,
@@ -627,7 +627,7 @@ class Frame3D(Rotations3D, LineFrame):
     dof_names = ("ux", "uy", "uz", "rx", "ry", "rz")
     translations = 3
     nprops = law3d.NPROPS
-    kernels = kernels3d
+    kernels = OnFirstUse("beam3d")
     symmetric_tangent = False  # spatial spins: K is symmetric only at equilibrium under conservative loads
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):

@@ -18,8 +18,7 @@ from ..elements import membrane_quad as quad_law
 from ..elements import shell_triangle as shell_law
 from ..conditions import Condition
 from ..io.mesh import TaggedMesh
-from ..kernels import membrane_quad as kernels_mq
-from ..kernels import shell3d as kernels_shell
+from ..kernels import CCW, RESULTANTS, OnFirstUse
 from ..loads import FollowerLoad
 from ..result import ElementResults
 from .base import PartRef
@@ -69,7 +68,7 @@ class Surface3D(Rotations3D, LineFrame):
         cells = cells[cells < n_owned]
         if self.comm.allreduce(int(np.any(self._owner_of_cell[cells] == "")), op=MPI.MAX):
             raise SurfaceError(f"contact surface '{where}': some of its cells carry no shell or membrane")
-        order = kernels_mq.CCW if self.nodes_per_cell == 4 else np.arange(3)
+        order = CCW if self.nodes_per_cell == 4 else np.arange(3)
         blocks = np.array([self.V.dofmap.cell_dofs(c) for c in cells], dtype=np.int64).reshape(-1, self.nodes_per_cell)
         props = self.cell_properties(cells)
         E, nu, t = props[:, 0], props[:, 1], props[:, 2]
@@ -99,7 +98,7 @@ class Surface3D(Rotations3D, LineFrame):
         self._distributed.append((label, where, along_initial_normals, amplitude, condition))
         return condition
 
-    section_components = kernels_shell.RESULTANTS
+    section_components = RESULTANTS
 
     def element_results(self, cells: np.ndarray | None = None, label: str = "",
                         gather: bool = True) -> ElementResults:
@@ -132,7 +131,7 @@ class Shell3D(Surface3D):
 
     nodes_per_cell = 3
     nprops = shell_law.NPROPS
-    kernels = kernels_shell
+    kernels = OnFirstUse("shell3d")
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
         if tmesh.mesh.topology.cell_name() != "triangle":
@@ -171,7 +170,7 @@ class MembraneQuad(Surface3D):
 
     nodes_per_cell = 4
     nprops = quad_law.NPROPS
-    kernels = kernels_mq
+    kernels = OnFirstUse("membrane_quad")
 
     def add_shell(self, where, E, nu, thickness, drilling, membrane) -> PartRef:
         raise NotImplementedError(f"shell '{where}': shells are triangles; this mesh has quadrilaterals, which "
@@ -187,6 +186,6 @@ class MembraneQuad(Surface3D):
         corners on a line or strongly warped (MeshError naming the first; see
         :func:`dolfinx_corot.parts.cells.quadrilateral_problems`)."""
         mesh = self.tmesh.mesh
-        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 4)[cells][:, kernels_mq.CCW]]
+        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 4)[cells][:, CCW]]
         problems = quadrilateral_problems(X, mesh_extent(mesh))
         refuse(mesh, label, [(problem, cells[bad]) for problem, bad in problems])

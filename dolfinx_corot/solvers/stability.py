@@ -74,8 +74,12 @@ def _label(model) -> str:
     return ", ".join(dict.fromkeys(names)) or model.kind_name
 
 
-def _fmt(x) -> str:
-    return "(" + ", ".join(f"{v:.4g}" for v in np.asarray(x, dtype=float)) + ")"
+def _fmt(x, length: float = 0.0) -> str:
+    """A point or vector in words; coordinates below 1e-12 of ``length`` (the model's size) are
+    round-off and read 0."""
+    x = np.asarray(x, dtype=float)
+    x = np.where(np.abs(x) < 1e-12 * length, 0.0, x)
+    return "(" + ", ".join(f"{v:.4g}" for v in x) + ")"
 
 
 def _rigid_fit(X: np.ndarray, t: np.ndarray):
@@ -151,9 +155,10 @@ def _describe_part(model, X: np.ndarray, v: np.ndarray, scene) -> str:
         if d == 2:
             w = float(w[0])
             centre = c + np.array([-a[1], a[0]]) / w
-            return f"{name} rotates freely about the point {_fmt(centre)}{held}"
+            return f"{name} rotates freely about the point {_fmt(centre, size)}{held}"
         axis = w / np.linalg.norm(w)
-        return f"{name} rotates freely about the axis {_fmt(axis)} through {_fmt(c + np.cross(w, a) / (w @ w))}{held}"
+        through = c + np.cross(w, a) / (w @ w)
+        return f"{name} rotates freely about the axis {_fmt(axis)} through {_fmt(through, size)}{held}"
     size = np.linalg.norm(t, axis=1)
     k = [i for i in np.argsort(-size)[:3] if size[i] > 0.1 * size.max()]
     return (f"{name} deforms without resistance (a mechanism): the node(s) at "
@@ -258,7 +263,10 @@ def free_rigid_motions(system, scene=None) -> list[str]:
 
 def _words_of_rigid(model, F: np.ndarray, centre: np.ndarray, scene) -> str:
     """Words for the span of the rigid-mode coefficients F (columns; translations first)."""
+    from ..parts.cells import mesh_extent
+
     d = model.gdim
+    length = mesh_extent(model.V.mesh)  # (collective, as the caller's search)
     Q, _ = np.linalg.qr(F)
     names = []
     for k in range(d):
@@ -277,10 +285,10 @@ def _words_of_rigid(model, F: np.ndarray, centre: np.ndarray, scene) -> str:
                     break
             if d == 2:
                 point = centre + np.array([-a[1], a[0]]) / w[0]
-                names.append(f"rotation about z through the point {_fmt(point)}")
+                names.append(f"rotation about z through the point {_fmt(point, length)}")
             else:
                 point = centre + np.cross(w, a) / (w @ w)
-                names.append(f"rotation about the axis {_fmt(w / np.linalg.norm(w))} through {_fmt(point)}")
+                names.append(f"rotation about the axis {_fmt(w / np.linalg.norm(w))} through {_fmt(point, length)}")
     return f"{_label(model)} moves freely ({', '.join(names)}){_contact_note(model, scene)}"
 
 

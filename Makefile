@@ -41,6 +41,7 @@ notebooks: setup-docs
 bench: setup
 	$(PY) benchmarks/startup.py                    # import and a small model's whole process, against import dolfinx
 	$(PY) benchmarks/beam2d.py
+	$(PY) benchmarks/hertz_same.py                 # Hertz, two equal elastic bodies (the peer comparison's set-up)
 	$(PY) benchmarks/pullout.py
 	$(PY) benchmarks/frame3d.py --sizes 7 15 32   # 10³, 10⁴, 10⁵ elements: about 20 minutes
 	$(PY) benchmarks/block3d.py                    # 116 k dofs SVK block: about 1 minute

@@ -179,6 +179,8 @@ def main() -> dict:
                 title="what accuracy costs (h_c = " + ", ".join(f"{r['h_contact']:g}" for r in rows) + ")")
     axes[1].legend(fontsize=7)
     demo.save(fig, "hertz_3d.png")
+    demo.work_precision([r["dofs"] for r in rows], [r["p0_error"] for r in rows], [r["wall_s"] for r in rows],
+                        quantity="peak pressure p0 (dofs)", reference="Hertz, Johnson (1985) §4.2: p0 = 3F/(2πa²)")
     demo.record(load_factor=[1.0] * len(rows), p0=[r["p0"] for r in rows], a=[r["a"] for r in rows],
                 force=[r["force"] for r in rows])  # (each run ends at λ = 1)
     # %% [markdown]

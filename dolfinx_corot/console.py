@@ -66,7 +66,8 @@ def announce_compilation(kind: str = "*", stream=None) -> bool:
 
     if MPI.COMM_WORLD.rank == 0:
         out = sys.stdout if stream is None else stream
-        what = "the element kernels" if kind == "*" else f"the {kind} element kernels"
-        out.write(f"dolfinx_corot: compiling {what}, once: about 20 s\n")
+        what = "the element kernels, once: about 40 s" if kind == "*" else \
+            f"the {kind} element kernels, once: about 15 s"
+        out.write(f"dolfinx_corot: compiling {what}\n")
         out.flush()
     return True

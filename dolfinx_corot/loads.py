@@ -24,7 +24,8 @@ from .elements import follower
 class FollowerLoad:
     """One follower load on the owned cells of a structural part.
 
-    kind: 'line2d' (intensity (q_a, q_n) per current length in element axes), 'triangle' or
+    kind: 'line2d' (intensity (q_a, q_n) per current length in element axes), 'line3d' ((q_1, q_2,
+    q_3) per current length in the current element axes of 3D beams and bars), 'triangle' or
     'quad' (a pressure p along the current normal); cells: the part's owned local cells;
     amplitude: None (∝ λ) or a function of λ; condition: the load's stage item."""
 
@@ -37,7 +38,8 @@ class FollowerLoad:
         self.amplitude, self.condition = amplitude, condition
         # node order of the dofmap: the kernels' (a quadrilateral's nodes at (0, 0), (1, 0), (0, 1), (1, 1))
         self.blocks = model.V.dofmap.list.array.reshape(-1, model.nodes_per_cell)[self.cells]
-        self.components = [0, 1, 2]  # 2D lines: ux, uy, rz; surfaces: ux, uy, uz
+        # 2D lines: ux, uy, rz; surfaces: ux, uy, uz; 3D lines: the translations and rotations
+        self.components = list(range(6)) if kind == "line3d" else [0, 1, 2]
 
     def factor(self, load_factor: float) -> float:
         return load_factor if self.amplitude is None else float(self.amplitude(load_factor))
@@ -59,6 +61,15 @@ class FollowerLoad:
         if self.kind == "line2d":
             q = np.broadcast_to(self.intensity, (len(self.cells), 2))
             return follower.line2d(x, q, self.bending)
+        if self.kind == "line3d":  # the element's current axes come from its nodal rotations
+            n = len(self.cells)
+            X = np.ascontiguousarray(m.reference[self.blocks])
+            S = np.ascontiguousarray(m.state.x.array.reshape(-1, m.state_size)[self.blocks])
+            f, K = np.empty((n, 12)), np.empty((n, 12, 12))
+            m.kernels.follower_loads_all(X, S, np.ascontiguousarray(m.cell_properties(self.cells)),
+                                         np.ascontiguousarray(np.broadcast_to(self.intensity, (n, 3))),
+                                         np.ascontiguousarray(self.bending, dtype=float), f, K)
+            return f, K
         p = np.broadcast_to(self.intensity, (len(self.cells),))
         return (follower.triangle if self.kind == "triangle" else follower.quad)(x, p)
 

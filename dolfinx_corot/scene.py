@@ -269,10 +269,11 @@ class Scene:
         * ``axes='element'``: components in each element's axes (2D: along the element, then
           normal to it, e_z × t; 3D: the beam's local x, y, z), dead: fixed at the element's
           reference axes;
-        * ``follower=True`` (2D, ``axes='element'``): the load turns with the element and acts per
+        * ``follower=True`` (``axes='element'``): the load turns with the element and acts per
           unit current length (a pressure on a ring or an arch: ``per_length=(0.0, -p)`` with the
-          normal e_z × t pointing away from the loaded side); its load stiffness enters the tangent
-          (:mod:`dolfinx_corot.loads`).
+          normal e_z × t pointing away from the loaded side; in 3D along the element's current
+          axes, e2 and e3 turning with its nodes' rotations); its load stiffness enters the
+          tangent (:mod:`dolfinx_corot.loads`).
 
         Returns the load as a :class:`~dolfinx_corot.conditions.Condition` (construction stages
         may add it — applied over that stage — or remove it — taken off over that stage).

@@ -177,6 +177,57 @@ def section_forces_all(X, S, props, large_rotations, out, axes):
         section_forces(X[e], S[e], props[e], large_rotations, out[e], axes[e])
 
 
+@numba.njit(cache=True)
+def _follower_force(X, u, R, R0, q, bending, f):
+    """f (12,) the nodal loads of a uniform load q (3,) per current length given in the element's
+    current axes (e1 along the chord, e2, e3 of the nodal rotations, as the element's frame) on
+    the element X (2, 3) at u (2, 3), R (2, 3, 3): half of q l at each node, and for a beam the
+    end moments ±(l²/12) e1 × q of a uniform span load. Real or complex (complex step)."""
+    dt = u.dtype
+    Rr = np.empty((3, 3), dtype=dt)
+    l = frame3d.current_frame(X[0], X[1], u[0], u[1], R[0], R[1], R0, Rr,
+                              np.empty(3, dtype=dt), np.empty(3, dtype=dt))
+    g = Rr @ q.astype(dt)  # the load per length in global axes
+    e1 = Rr[:, 0]
+    m = np.empty(3, dtype=dt)
+    m[0] = e1[1] * g[2] - e1[2] * g[1]
+    m[1] = e1[2] * g[0] - e1[0] * g[2]
+    m[2] = e1[0] * g[1] - e1[1] * g[0]
+    for k in range(3):
+        f[k] = f[6 + k] = 0.5 * l * g[k]
+        f[3 + k] = l * l / 12.0 * bending * m[k]
+        f[9 + k] = -f[3 + k]
+
+
+@numba.njit(cache=True)
+def follower_loads(X, S, props, q, bending, f, K):
+    """:func:`_follower_force` of one element (X (2, 3), S (2, 7), props: its orientation vector)
+    into f (12,), and K (12, 12) = ∂f/∂d over the translations and the rotation increments
+    (R ← exp(δθ) R), by complex-step differentiation."""
+    R0 = np.empty((3, 3))
+    frame3d.initial_frame(X[0], X[1], props[law.VX:law.VZ + 1], R0)
+    u = np.empty((2, 3))
+    R = np.empty((2, 3, 3))
+    nodal_states(S, u, R)
+    fc = np.empty(12, dtype=np.complex128)
+    _follower_force(X, u.astype(np.complex128), R.astype(np.complex128), R0, q, bending, fc)
+    f[:] = fc.real
+    up = np.empty((2, 3), dtype=np.complex128)
+    Rp = np.empty((2, 3, 3), dtype=np.complex128)
+    for j in range(12):
+        perturb(u.astype(np.complex128), R.astype(np.complex128), j, up, Rp)
+        _follower_force(X, up, Rp, R0, q, bending, fc)
+        K[:, j] = fc.imag / H
+
+
+@numba.njit(cache=True)
+def follower_loads_all(X, S, props, q, bending, f, K):
+    """:func:`follower_loads` of every element: X (n, 2, 3), S (n, 2, 7), q (n, 3), bending (n,) →
+    f (n, 12), K (n, 12, 12)."""
+    for e in range(X.shape[0]):
+        follower_loads(X[e], S[e], props[e], q[e], bending[e], f[e], K[e])
+
+
 @numba.njit(cache=True, inline="always")
 def _tabulate(w, c, X, f, K, tangent):
     """The element function of the DOLFINx kernels (see :mod:`.ufcx`)."""

@@ -194,13 +194,11 @@ class LineFrame(Part):
         cells = self._loaded_cells(part, where, "load per length")
         condition = condition or Condition("load", f"per length on {label}")
         if follower:
-            if self.gdim != 2:
-                raise NotImplementedError(f"follower load per length on {label}: 2D beams and bars only; in 3D "
-                                          "give a dead load (follower=False) in global or element axes")
             if axes != "element":
                 raise ValueError(f"follower load per length on {label}: a follower load turns with the elements, "
                                  "so give it in element axes (axes='element': along the element, normal to it)")
-            self.followers.append(FollowerLoad(self, label, "line2d", cells, q, self._bending[cells], amplitude,
+            kind = "line2d" if self.gdim == 2 else "line3d"
+            self.followers.append(FollowerLoad(self, label, kind, cells, q, self._bending[cells], amplitude,
                                                condition))
             return condition
         if axes == "global":

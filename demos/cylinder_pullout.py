@@ -113,6 +113,9 @@ def three_meshes(demo):
                np.c_[np.r_[np.ones(len(meshes)), np.zeros(len(meshes))], np.vstack([studies["opt"], studies["cst"]])],
                ["opt_membrane", "n_theta", "n_x", "P_at_wA_2.5", "wB_at_wA_2.5", "uC_at_wA_2.5", "wall_s",
                 "iterations", "cuts", "P_last"])
+    opt = studies["opt"]
+    demo.work_precision_to_finest((opt[:, 0] * opt[:, 1]).astype(int), opt[:, 2], opt[:, 5],
+                                  quantity=f"P at w_A = {W_CHECK}, OPT membrane (cells n_θ × n_x)")
     return studies, curves
 
 

@@ -100,6 +100,8 @@ def three_meshes(demo):
     study = np.array(study)
     demo.table("mesh_convergence.csv", study,
                ["n", "P_max", "P_valley", "wall_s", "iterations", "cuts", "max_iterations_per_step"])
+    demo.work_precision_to_finest(study[:, 0].astype(int), study[:, 1], study[:, 3],
+                                  quantity="limit load (squares along an edge)")
     return study, curves
 
 

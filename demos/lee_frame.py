@@ -109,6 +109,7 @@ def mesh_convergence(demo):
     study = np.array(study)
     demo.table("mesh_convergence.csv", study,
                ["elements", "P_max_L2_over_EI", "P_min_L2_over_EI", "wall_time_s", "cuts"])
+    demo.work_precision_to_finest(study[:, 0].astype(int), study[:, 1], study[:, 3], quantity="limit load (elements)")
     return study
 
 

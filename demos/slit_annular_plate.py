@@ -103,6 +103,8 @@ def three_meshes(demo):
     study = np.array(study)
     demo.table("mesh_convergence.csv", study,
                ["n_r", "n_theta", "wA", "wB", "wall_s", "iterations", "cuts", "max_iterations_per_step"])
+    demo.work_precision_to_finest((study[:, 0] * study[:, 1]).astype(int), study[:, 2], study[:, 4],
+                                  quantity="w_A at q = 0.8 (cells n_r × n_θ)")
     return study, hists
 
 

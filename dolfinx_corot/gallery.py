@@ -159,6 +159,16 @@ class Demo:
                            "error": [abs(float(error[k])) for k in keep], "time": [float(time[k]) for k in keep]}, f,
                           indent=1)
 
+    def work_precision_to_finest(self, resolution: Sequence, value: Sequence[float], time: Sequence[float], *,
+                                 quantity: str) -> None:
+        """:meth:`work_precision` of a self-convergence study: the error of each run is its relative
+        distance from the finest run's ``value`` (the finest run itself left out of the plot)."""
+        value = np.asarray(value, dtype=float)
+        error = np.abs(value / value[-1] - 1.0)
+        error[-1] = np.nan
+        self.work_precision(resolution, error, time, quantity=quantity,
+                            reference=f"self-convergence: the finest run ({_plain(resolution[-1])})")
+
     def table(self, filename: str, rows: Union[Sequence[dict], np.ndarray],
               columns: Optional[Sequence[str]] = None) -> None:
         """``<out>/<filename>`` as CSV, on rank 0: dict rows (the first row's keys as header), or

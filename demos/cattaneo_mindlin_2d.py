@@ -297,6 +297,10 @@ def plot(demo, rows, profiles):
     ax = axes[1]
     sizes = sorted({r["h"] for r in rows}, reverse=True)
     wall = [next(r["wall_s"] for r in rows if r["h"] == h) for h in sizes]
+    demo.work_precision([f"a/{A_HERTZ / h:.0f}" for h in sizes],
+                        [max(abs(r["q_rms_error"]) for r in rows if r["h"] == h) for h in sizes], wall,
+                        quantity="shear traction, rms / μp₀ (element size)",
+                        reference="Cattaneo (1938), Mindlin (1949): q = μp₀(√(1 − x²/a²) − (c/a)√(1 − x²/c²))")
     for key, mark in (("c_error", "o-"), ("q_rms_error", "s--")):
         ax.loglog(wall, [max(abs(r[key]) for r in rows if r["h"] == h) for h in sizes], mark,
                   label=f"largest |{key}| over the four Q")

@@ -15,7 +15,9 @@ top of one another for frames)::
 Every part kind is drawn: beams and bars as tubes of their section's radius (lines in a plane
 for 2D scenes), shells and membranes as surfaces, solids by their boundary faces; cells that do
 not exist in a stage are left out. Fields: ``"displacement"`` (``|u|``), ``"rotation"`` (``|θ|`` of
-the nodal rotations, zero for parts without them), or ``"none"`` (one colour per part). The
+the nodal rotations, zero for parts without them), ``"mises"`` (the von Mises stress of solids'
+cells, of shells' and membranes' larger face value, averaged at the nodes; zero for beams), or
+``"none"`` (one colour per part). The
 undeformed shape is drawn in grey, the camera looks along z for 2D scenes and isometrically in
 3D, and the colour range is shared by every state of a picture.
 
@@ -40,7 +42,7 @@ from mpi4py import MPI
 
 __all__ = ["Snapshots", "State", "capture", "diagram", "grid_of", "picture"]
 
-FIELDS = {"displacement": "displacement", "rotation": "rotation (rad)", "none": None}
+FIELDS = {"displacement": "displacement", "rotation": "rotation (rad)", "mises": "von Mises stress", "none": None}
 LINE_CELLS = ("interval",)
 VTK_CELLS = {"interval": 3, "triangle": 5, "quadrilateral": 9, "tetrahedron": 10, "hexahedron": 12}
 
@@ -162,6 +164,13 @@ def _grid(pv, part: dict, deformed: bool, scale: float, field: str):
     elif field == "rotation":
         rot = part["rotation"]
         values = np.zeros(len(unique)) if rot is None else rot[keep].ravel()[first]
+    elif field == "mises":  # the cells' values averaged at the points they share
+        mises = part.get("mises")
+        values = np.zeros(len(unique))
+        if mises is not None:
+            count = np.bincount(connectivity.ravel(), minlength=len(unique))
+            values = np.bincount(connectivity.ravel(), np.repeat(np.asarray(mises)[keep], nv),
+                                 minlength=len(unique)) / np.maximum(count, 1)
     if values is not None:
         grid.point_data["field"] = values
     if part["size"] is not None:

@@ -128,6 +128,28 @@ def test_bodies_that_touch_stay_apart_in_the_drawing(tmp_path):
         assert _coloured_fraction(path) > 0.01
 
 
+def test_a_stretched_block_is_drawn_with_its_von_mises_stress(tmp_path):
+    """A plane-strain block (ν = 0) stretched by 1 % with free sides, small strain: every node of
+    the picture carries the exact von Mises stress of the uniaxial state (σ_xx = Eε, σ_zz = 0: Eε),
+    from the cells' element results averaged at the nodes."""
+    E, eps = 1e3, 0.01
+    tm = from_arrays(np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 1.0], [2.0, 1.0]]), np.array([[0, 1, 3], [0, 3, 2]]),
+                     "block", {"left": [0, 2], "corner": [0], "right": [1, 3]}, comm=comm)
+    sc = dc.Scene(large_rotations=False)
+    block = sc.add_solid(tm, "block", material=dc.Elastic(E, 0.0), degree=1)
+    sc.fix(block, "left", dofs=("ux",))
+    sc.fix(block, "corner", dofs=("uy",))
+    sc.prescribe(block, "right", ux=2.0 * eps)
+    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
+    state = plot.capture(sc)
+    if comm.rank == 0:
+        grid = plot.grid_of(state.parts[0], field="mises")
+        np.testing.assert_allclose(grid.point_data["field"], E * eps, rtol=1e-9)
+    path = plot.picture(state, str(tmp_path / "mises.png"), field="mises")
+    if comm.rank == 0:
+        assert _coloured_fraction(path) > 0.01
+
+
 def test_bad_picture_options_are_refused(tmp_path):
     sc, _ = _rollup()
     state = plot.capture(sc)

@@ -491,12 +491,26 @@ class Part:
             rotation = np.linalg.norm(values.reshape(len(values), -1), axis=1)[blocks]
         n_owned = len(X)
         size = self._drawn_sizes(np.arange(n_owned, dtype=np.int32))
-        parts = self.comm.gather((X, u, exists, rotation, size), root=root)
+        mises = self._drawn_mises(n_owned)
+        parts = self.comm.gather((X, u, exists, rotation, size, mises), root=root)
         if parts is None:
             return None
         join = (lambda k: None if parts[0][k] is None else np.concatenate([p[k] for p in parts]))
         return {"cell": self.V.mesh.topology.cell_name(), "gdim": self.gdim, "X": join(0), "u": join(1),
-                "exists": join(2), "rotation": join(3), "size": join(4), "kind": self.kind_name}
+                "exists": join(2), "rotation": join(3), "size": join(4), "mises": join(5), "kind": self.kind_name}
+
+    def _drawn_mises(self, n_owned: int) -> np.ndarray | None:
+        """(n_owned,) the von Mises stress of the owned cells for pictures (solids: at the centre;
+        shells and membranes: the larger of the faces'; 0 where no element exists); None for parts
+        without it."""
+        components = getattr(self, "section_components", ())
+        names = [c for c in ("mises", "mises_top", "mises_bottom") if c in components]
+        if not names:
+            return None
+        local = self.element_results(gather=False)
+        out = np.zeros(n_owned)
+        out[local.cells] = np.max([local[c].max(axis=1) for c in names], axis=0)
+        return out
 
     # -- element results ------------------------------------------------------------
     def element_results(self, cells: np.ndarray | None = None, label: str = "",

@@ -102,7 +102,9 @@ def scene(h: float, setting: str):
 #
 # The symmetric setting on the fine mesh (run under CI too) is pictured at F = 100, 200, 400
 # and 600 (`footing_shapes.png`): the footing sinking into the soil, displacements magnified
-# ten times and coloured by their magnitude, the undeformed outline in grey.
+# ten times and coloured by their magnitude, the undeformed outline in grey;
+# `footing_contact.png` colours the last state by the interface pressure (both passes
+# combined) on the soil's top and the footing's nodes.
 
 # %%
 meshes = {"coarse": 1 / 8, "fine": 1 / 16}
@@ -150,6 +152,9 @@ def runs(demo):
                     state.label = f"F = {F * state.load_factor:.0f}"
                 demo.picture(shots, "footing_shapes.png", scale=SCALE, columns=2, window_size=(1400, 900),
                              show_edges=False, title=f"{mesh_name} mesh, {setting}")
+                demo.picture(shots.states[-1:], "footing_contact.png", scale=SCALE, window_size=(1400, 600),
+                             show_edges=False, field="contact", zoom=2.0,
+                             title=f"{mesh_name} mesh, {setting}: contact pressure")
             demo.say(f"{mesh_name:6s} {setting:9s}: settlement {row['settlement']:.5f}, "
                      f"base reaction {row['base_Fy']:.8f}, "
                      f"Σ p L = {pressure:.6f}; {row['newton_iterations']} Newton its, {row['cuts']} cuts, "

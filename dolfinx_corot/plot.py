@@ -17,7 +17,8 @@ for 2D scenes), shells and membranes as surfaces, solids by their boundary faces
 not exist in a stage are left out. Fields: ``"displacement"`` (``|u|``), ``"rotation"`` (``|θ|`` of
 the nodal rotations, zero for parts without them), ``"mises"`` (the von Mises stress of solids'
 cells, of shells' and membranes' larger face value, averaged at the nodes; zero for beams), or
-``"none"`` (one colour per part). The
+``"contact"`` (the interface pressure of every contact pair, both passes combined, at the nodes
+of either side; zero elsewhere) or ``"none"`` (one colour per part). The
 undeformed shape is drawn in grey, the camera looks along z for 2D scenes and isometrically in
 3D, and the colour range is shared by every state of a picture.
 
@@ -42,7 +43,8 @@ from mpi4py import MPI
 
 __all__ = ["Snapshots", "State", "capture", "diagram", "grid_of", "picture"]
 
-FIELDS = {"displacement": "displacement", "rotation": "rotation (rad)", "mises": "von Mises stress", "none": None}
+FIELDS = {"displacement": "displacement", "rotation": "rotation (rad)", "mises": "von Mises stress",
+          "contact": "contact pressure", "none": None}
 LINE_CELLS = ("interval",)
 VTK_CELLS = {"interval": 3, "triangle": 5, "quadrilateral": 9, "tetrahedron": 10, "hexahedron": 12}
 
@@ -61,6 +63,24 @@ def capture(scene, label: str = "", load_factor: float | None = None) -> State:
     """The current state of ``scene`` (collective)."""
     models = scene.model.models if scene.model.coupled else [scene.model]
     drawings = [m.drawing() for m in models]
+    # the interface pressure of every contact pair (both passes combined) on either side's nodes
+    sides = []
+    for pair in getattr(scene, "pairs", []):
+        for side in pair.SIDES:
+            first = pair.interfaces[0]
+            surface = first.slave if pair.on_slaves(side) else first.master
+            sides.append((surface.part, pair.pressure(side)))  # (collective)
+    for model, drawing in zip(models, drawings):
+        if drawing is None or not any(part is model for part, _ in sides):
+            continue
+        keys = drawing["keys"]
+        values = np.zeros(keys.shape)
+        for part, pressure in sides:
+            if part is model and len(pressure.keys):
+                at = np.minimum(np.searchsorted(pressure.keys, keys), len(pressure.keys) - 1)
+                hit = pressure.keys[at] == keys
+                values[hit] = np.maximum(values[hit], pressure.pressure[at[hit]])
+        drawing["contact"] = values
     return State(label, load_factor, [d for d in drawings if d is not None])
 
 
@@ -164,6 +184,9 @@ def _grid(pv, part: dict, deformed: bool, scale: float, field: str):
     elif field == "rotation":
         rot = part["rotation"]
         values = np.zeros(len(unique)) if rot is None else rot[keep].ravel()[first]
+    elif field == "contact":
+        pressure = part.get("contact")
+        values = np.zeros(len(unique)) if pressure is None else np.asarray(pressure)[keep].ravel()[first]
     elif field == "mises":  # the cells' values averaged at the points they share
         mises = part.get("mises")
         values = np.zeros(len(unique))
@@ -204,7 +227,8 @@ def picture(states, filename: str, *, field: str = "displacement", scale: float 
     PNG ``filename``; returns the path on rank 0, None on the others (collective when given a
     scene, which is captured first).
 
-    field: 'displacement' (``|u|``), 'rotation' (``|θ|``) or 'none'; scale: displacement magnification;
+    field: 'displacement' (``|u|``), 'rotation' (``|θ|``), 'mises' (von Mises stress), 'contact'
+    (interface pressure) or 'none'; scale: displacement magnification;
     layout: 'overlay' (every state in one view: frames), 'grid' (one view each, ``columns`` per
     row), 'auto' (overlay when every part is made of lines, else grid); undeformed: the initial
     shape in grey (a thin outline of surfaces and solids); camera: 'xy' (2D scenes' default),

@@ -93,6 +93,7 @@ class Scene:
         self._loads = 0
         self._prescribed = 0
         self.interfaces: list = []
+        self.pairs: list[ContactPair] = []  # what contact() returned, in order
         self.stabilisers: list[Stabiliser] = []
 
     # -- parts -----------------------------------------------------------------
@@ -422,7 +423,8 @@ class Scene:
         if symmetric:
             made.append(kind(masters, slaves, law, smooth, **extra))
         self.interfaces += made
-        return ContactPair(made)
+        self.pairs.append(ContactPair(made))
+        return self.pairs[-1]
 
     def stabilise(self, part: PartRef, stiffness: float | None = None, where: str | None = None, *,
                   rotational_stiffness: float | None = None, factor: float = 1e-6, tolerance: float = 1e-9,

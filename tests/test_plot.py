@@ -7,7 +7,7 @@ from mpi4py import MPI
 import dolfinx_corot as dc
 from dolfinx_corot import plot
 from dolfinx_corot.io.gmsh_models import polyline
-from dolfinx_corot.io.mesh import from_arrays
+from dolfinx_corot.io.mesh import from_arrays, rectangles
 
 comm = MPI.COMM_WORLD
 pytest.importorskip("pyvista")
@@ -148,6 +148,36 @@ def test_a_stretched_block_is_drawn_with_its_von_mises_stress(tmp_path):
     path = plot.picture(state, str(tmp_path / "mises.png"), field="mises")
     if comm.rank == 0:
         assert _coloured_fraction(path) > 0.01
+
+
+def test_two_pressed_blocks_are_drawn_with_their_contact_pressure(tmp_path):
+    """Two blocks pressed together by a uniform stress P (the two-pass patch test of
+    test_contact_pressure.py): the picture's contact field is P at the nodes of both faces in
+    contact and 0 at every other node."""
+    P = 0.01
+    tm = rectangles({"lower": (0.0, 0.0, 1.0, 1.0, 3, 2), "upper": (0.0, 1.0, 1.0, 1.0, 4, 2)},
+                    {"base": [("lower", "bottom")], "lower_top": [("lower", "top")],
+                     "upper_bottom": [("upper", "bottom")], "top": [("upper", "top")],
+                     "left": [("lower", "left"), ("upper", "left")]}, comm=comm)
+    sc = dc.Scene()
+    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(1.0, 0.3), degree=1)
+    sc.fix(b, "base", dofs=("uy",))
+    sc.fix(b, "left", dofs=("ux",))
+    sc.load(b, "top", traction=(0.0, -P))
+    sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), symmetric=True, smooth=False,
+               law=dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4))
+    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
+    state = plot.capture(sc)
+    if comm.rank == 0:
+        grid = plot.grid_of(state.parts[0], field="contact", deformed=False)
+        on = np.isclose(grid.points[:, 1], 1.0)
+        p = grid.point_data["field"]
+        assert on.sum() == 9  # the lower block's 4 nodes at y = 1 and the upper one's 5
+        np.testing.assert_allclose(p[on], P, rtol=1e-7)
+        assert np.all(p[~on] == 0.0)
+    path = plot.picture(state, str(tmp_path / "contact.png"), field="contact")
+    if comm.rank == 0:
+        assert _coloured_fraction(path) > 0.001
 
 
 def test_bad_picture_options_are_refused(tmp_path):

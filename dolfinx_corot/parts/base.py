@@ -482,8 +482,9 @@ class Part:
         (None on the other ranks): ``cell`` (the cell name), ``gdim``, ``X`` (cells, vertices, gdim)
         the initial positions of the vertices of every cell, ``u`` their displacements, ``exists``
         (cells,), ``rotation`` (cells, vertices) the magnitude of the nodal rotations (None for a
-        part without rotations) and ``size`` (cells,) the drawn size of each cell (a beam's radius, a
-        shell's thickness; None for solids). Collective."""
+        part without rotations), ``size`` (cells,) the drawn size of each cell (a beam's radius, a
+        shell's thickness; None for solids), ``mises`` (cells,) their von Mises stress (None for
+        beams) and ``keys`` (cells, vertices) the vertices' global node numbers. Collective."""
         X, u, exists, blocks = self._owned_cell_drawing()
         rotation = None
         if self.ndof > self.translations:
@@ -492,12 +493,14 @@ class Part:
         n_owned = len(X)
         size = self._drawn_sizes(np.arange(n_owned, dtype=np.int32))
         mises = self._drawn_mises(n_owned)
-        parts = self.comm.gather((X, u, exists, rotation, size, mises), root=root)
+        keys = self.V.dofmap.index_map.local_to_global(blocks.ravel().astype(np.int32)).reshape(blocks.shape)
+        parts = self.comm.gather((X, u, exists, rotation, size, mises, keys), root=root)
         if parts is None:
             return None
         join = (lambda k: None if parts[0][k] is None else np.concatenate([p[k] for p in parts]))
         return {"cell": self.V.mesh.topology.cell_name(), "gdim": self.gdim, "X": join(0), "u": join(1),
-                "exists": join(2), "rotation": join(3), "size": join(4), "mises": join(5), "kind": self.kind_name}
+                "exists": join(2), "rotation": join(3), "size": join(4), "mises": join(5), "keys": join(6),
+                "kind": self.kind_name}
 
     def _drawn_mises(self, n_owned: int) -> np.ndarray | None:
         """(n_owned,) the von Mises stress of the owned cells for pictures (solids: at the centre;

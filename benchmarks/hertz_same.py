@@ -10,7 +10,7 @@ the peak pressure of the computed contact are those of Hertz's ellipse pÂ² = pâ‚
 fitted to the nodal pressures (both passes combined); each is compared with Hertz's value at
 the computed F. Three meshes (size h near the contact point, growing to R/8 away from it).
 
-Writes output/hertz_same/{hertz_same.json, hertz_same.csv}.
+Writes output/hertz_same/{hertz_same.json, hertz_same.csv, hertz_same.png}.
 Usage: python benchmarks/hertz_same.py [--sizes 0.2 0.1 0.05]
 """
 import argparse
@@ -114,6 +114,20 @@ def main() -> None:
             writer = csv.DictWriter(f, fieldnames=list(rows[0]))
             writer.writeheader()
             writer.writerows(rows)
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(6, 4))
+        ax = fig.subplots()
+        for key, mark in (("p0_error", "o-"), ("a_error", "s--")):
+            ax.loglog([r["wall_s"] for r in rows], [abs(r[key]) for r in rows], mark, label=f"|{key.split('_')[0]} error|")
+        for r in rows:
+            ax.annotate(f"h = {r['h']:g}", (r["wall_s"], abs(r["p0_error"])), fontsize=7)
+        ax.axhline(0.01, color="0.5", ls=":", lw=0.8, label="1 %")
+        ax.set(xlabel="wall time of the whole run [s]", ylabel="relative error against Hertz",
+               title="Hertz, two equal elastic bodies")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "hertz_same.png"), dpi=110)
         for r in rows:
             print(f"h = {r['h']:5.3f} ({r['cells']:6d} cells, a/h = {r['a_over_h']:5.1f}): F = {r['F']:9.2f}, "
                   f"p0 {r['p0']:9.2f} ({r['p0_error']:+.2%} of Hertz), a {r['a']:.4f} ({r['a_error']:+.2%}); "

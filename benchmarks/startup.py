@@ -12,7 +12,7 @@ of each are reported:
   (``dc.solve``) measured inside it: the first time (the beam kernels are loaded from numba's
   cache then) and, in another process, for the same scene solved again (the solver alone).
 
-Writes output/startup_bench/{startup.json, startup.csv}.
+Writes output/startup_bench/{startup.json, startup.csv, startup.png}.
 Usage: python benchmarks/startup.py [--repeats 7]
 """
 import argparse
@@ -111,6 +111,16 @@ def main() -> None:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(7.5, 3.2))
+    ax = fig.subplots()
+    ax.barh([r["what"] for r in rows][::-1], [r["wall_s"] for r in rows][::-1], color="C0")
+    ax.axvline(floor, color="0.4", ls="--", lw=0.8, label="import dolfinx")
+    ax.set(xlabel="wall time of a fresh process, median [s]", title=f"start-up ({args.repeats} runs each)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, "startup.png"), dpi=110)
     print(f"{'':32s} {'wall (median)':>14s} {'/ import dolfinx':>17s} {'peak RSS':>10s}")
     for r in rows:
         print(f"{r['what']:32s} {r['wall_s']:12.3f} s {r['ratio_to_import_dolfinx']:17.2f} {r['peak_rss_MB']:7.0f} MB")

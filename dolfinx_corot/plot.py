@@ -245,6 +245,10 @@ def picture(states, filename: str, *, field: str = "displacement", scale: float 
     if not isinstance(states, (State, list, tuple)):
         states = capture(states, title or "")
     states = [states] if isinstance(states, State) else list(states)
+    if MPI.COMM_WORLD.rank == 0 and field in ("contact", "mises") and states and \
+            not any(part.get(field) is not None for state in states for part in state.parts):
+        what = "contact pairs (scene.contact)" if field == "contact" else "solids, shells or membranes"
+        raise ValueError(f"picture: field '{field}' draws {FIELDS[field]}, and the states hold no {what}")
     if MPI.COMM_WORLD.rank != 0:
         return None
     if not states or not states[0].parts:

@@ -325,3 +325,10 @@ def test_element_results_refuse_what_they_cannot_give():
         r["Mz"]
     with pytest.raises(ValueError, match="no element point"):
         r.at((5.0, 5.0))
+    from matplotlib.figure import Figure
+
+    ax = Figure().subplots()
+    with pytest.raises(ValueError, match="section forces have no component 'Mz'"):
+        dc.plot.diagram(ax, r, "Mz")
+    with pytest.raises(ValueError, match="diagrams are drawn for the section forces of beams"):
+        dc.plot.diagram(ax, r.__class__("stresses", ("sxx",), [], np.zeros((0, 1, 2)), np.zeros((0, 1, 1))), "sxx")

@@ -189,6 +189,11 @@ def test_bad_picture_options_are_refused(tmp_path):
         plot.picture(state, str(tmp_path / "x.png"), layout="stack")
     with pytest.raises(ValueError, match="no state was kept"):
         plot.Snapshots(sc).picture(str(tmp_path / "x.png"))
+    if comm.rank == 0:  # (the states are drawn on rank 0: it refuses what it cannot draw)
+        with pytest.raises(ValueError, match="field 'contact' draws contact pressure, and the states hold no contact"):
+            plot.picture(state, str(tmp_path / "x.png"), field="contact")
+        with pytest.raises(ValueError, match="field 'mises' draws von Mises stress, and the states hold no solids"):
+            plot.picture(state, str(tmp_path / "x.png"), field="mises")
 
 
 def test_snapshots_keep_the_last_step_of_each_stage(tmp_path):

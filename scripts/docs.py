@@ -180,14 +180,17 @@ def accuracy_page(names: list[str]) -> None:
              "quantity against the wall time of the run, mesh by mesh (shortened runs, one core; the "
              "machine's load shifts the times, not the errors).", ""]
     if series:
-        fig = Figure(figsize=(8, 5.5))
+        fig = Figure(figsize=(11, 5.5))
         ax = fig.subplots()
-        for name, data in series:
-            ax.loglog(data["time"], data["error"], "o-", ms=4, label=f"{name}: {data['quantity']}")
+        colours = [f"C{k % 10}" for k in range(len(series))]
+        markers = "os^vDP*Xhp<>"
+        for k, (name, data) in enumerate(series):  # a colour and a marker each: more demos than colours
+            ax.loglog(data["time"], data["error"], "-", marker=markers[k % len(markers)], color=colours[k], ms=5,
+                      label=f"{name}: {data['quantity']}")
         ax.set_xlabel("wall time [s]")
         ax.set_ylabel("relative error")
         ax.grid(True, which="both", lw=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0))
         fig.tight_layout()
         fig.savefig(GALLERY / "accuracy_vs_time.png", dpi=110)
         lines += ["![every demo's error against wall time](gallery/accuracy_vs_time.png)", ""]

@@ -53,6 +53,7 @@ import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
+from dolfinx_corot.closed_forms import hertz_ellipse_fit
 from dolfinx_corot.gallery import Demo, timed
 from dolfinx_corot.io import reference
 from dolfinx_corot.io.mesh import name_groups
@@ -135,10 +136,7 @@ def mesh(h_contact: float, h_foundation: float):
 # %%
 def hertz_fit(x, p):
     """(p₀, b) of the ellipse p² = p₀²(1 − x²/b²) fitted to nodal pressures (least squares)."""
-    on = p > 0.0
-    A = np.column_stack([np.ones(on.sum()), x[on] ** 2])
-    (a, c), *_ = np.linalg.lstsq(A, p[on] ** 2, rcond=None)
-    return np.sqrt(a), np.sqrt(a / -c)
+    return hertz_ellipse_fit(x, p)
 
 
 def run(name: str, h_contact: float, h_foundation: float, steps: int, shots_at: tuple | None = None):

@@ -37,6 +37,7 @@ import numpy as np
 from mpi4py import MPI
 
 import dolfinx_corot as dc
+from dolfinx_corot.closed_forms import hertz_ellipse_fit
 from dolfinx_corot.gallery import Demo, timed
 from dolfinx_corot.io.mesh import name_groups
 
@@ -105,10 +106,7 @@ def mesh(h_contact: float):
 # %%
 def hertz_fit(r, p):
     """(p₀, a) of the ellipse p² = p₀²(1 − r²/a²) fitted to the nodal pressures above 0.2 p_max."""
-    on = p > 0.2 * p.max()
-    A = np.column_stack([np.ones(on.sum()), r[on] ** 2])
-    (c0, c1), *_ = np.linalg.lstsq(A, p[on] ** 2, rcond=None)
-    return np.sqrt(c0), np.sqrt(c0 / -c1)
+    return hertz_ellipse_fit(r, p, above=0.2)
 
 
 def run(h_contact: float, steps: int = 5, shots_at: tuple | None = None) -> dict:

@@ -65,3 +65,14 @@ def _cantilever_elastica(k: float, load, points: int, name: str) -> dict:
     theta, dtheta, x, y = sol.sol(s)
     return {"x_tip": float(x[-1]), "y_tip": float(y[-1]), "theta_tip": float(theta[-1]), "s": s, "x": x, "y": y,
             "moment": dtheta / k}
+
+
+def hertz_ellipse_fit(x: np.ndarray, p: np.ndarray, above: float = 0.0) -> tuple[float, float]:
+    """(p₀, a) of Hertz's ellipse p² = p₀² (1 − x²/a²) fitted by least squares to nodal pressures p at
+    distances x from the centre of contact (line contact: x; point contact: the radius), over the
+    nodes whose pressure exceeds ``above`` × the largest (0: every node in contact)."""
+    x, p = np.asarray(x, dtype=float), np.asarray(p, dtype=float)
+    on = p > max(above * p.max(), 0.0)
+    A = np.column_stack([np.ones(on.sum()), x[on] ** 2])
+    (c0, c1), *_ = np.linalg.lstsq(A, p[on] ** 2, rcond=None)
+    return float(np.sqrt(c0)), float(np.sqrt(c0 / -c1))

@@ -166,18 +166,10 @@ def test_field_writer_writes_the_interface_pressure_at_the_nodes_of_each_side(tm
     """Two blocks pressed together by a uniform stress P (the two-pass patch test of
     test_contact_pressure.py): the contact pressure written at the nodes of both interface sides is P
     (to the Newton tolerance), 0 at every other node."""
-    P = 0.01
-    tm = rectangles({"lower": (0.0, 0.0, 1.0, 1.0, 3, 2), "upper": (0.0, 1.0, 1.0, 1.0, 4, 2)},
-                    {"base": [("lower", "bottom")], "lower_top": [("lower", "top")],
-                     "upper_bottom": [("upper", "bottom")], "top": [("upper", "top")],
-                     "left": [("lower", "left"), ("upper", "left")]}, comm=comm)
-    sc = dc.Scene()
-    b = sc.add_solid(tm, material=dc.SaintVenantKirchhoff(1.0, 0.3), degree=1)
-    sc.fix(b, "base", dofs=("uy",))
-    sc.fix(b, "left", dofs=("ux",))
-    sc.load(b, "top", traction=(0.0, -P))
-    pair = sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), symmetric=True, smooth=False,
-                      law=dc.AugmentedLagrangian(gap_tolerance=1e-12, factor=1e4))
+    from test_contact_pressure import EXACT, P, _blocks
+
+    sc, b = _blocks(3, 4)
+    pair = sc.contact(slaves=(b, "upper_bottom"), masters=(b, "lower_top"), law=EXACT, symmetric=True, smooth=False)
     path = comm.bcast(str(tmp_path / "contact.xdmf") if comm.rank == 0 else None, root=0)
     with dc.io.FieldWriter(sc, path, contacts=[pair]) as writer:
         dc.solve(sc, dc.LoadControl(steps=1), on_step=writer)

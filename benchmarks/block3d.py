@@ -68,6 +68,10 @@ def main():
     system.destroy()
     out = output_dir("block3d")  # collective
     if comm.rank == 0:
+        from summary import record
+
+        record("block3d", f"{data['dofs']} dofs, SVK, {data['steps']} steps", ranks=comm.size, wall_s=wall,
+               solver_s=wall - t_setup, peak_rss_MB=rss, newton_iterations=it)
         print(json.dumps(data, indent=1))
         stem = os.path.join(out, f"bench_{'x'.join(map(str, args.mesh))}_p{args.degree}_np{comm.size}")
         with open(stem + ".json", "w") as f:

@@ -99,6 +99,12 @@ def main() -> None:
     args = parser.parse_args()
     rows = [run(h) for h in args.sizes]
     if comm.rank == 0:
+        from summary import record
+
+        for r in rows:
+            record("hertz_same", f"h = {r['h']:g}", ranks=comm.size, wall_s=r["wall_s"], solver_s=r["solve_s"],
+                   peak_rss_MB=r["peak_rss_MB"], newton_iterations=r["newton_iterations"],
+                   error=f"p0 {r['p0_error']:+.2%}, a {r['a_error']:+.2%}", reference="Hertz, E* = E/(2(1 − ν²))")
         out = os.path.join(os.environ.get("DC_OUTPUT_DIR", "output"), "hertz_same")
         os.makedirs(out, exist_ok=True)
         with open(os.path.join(out, "hertz_same.json"), "w") as f:

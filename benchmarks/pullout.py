@@ -10,6 +10,7 @@ Usage: python benchmarks/pullout.py [--mesh 24 36] [--steps 28] [--w-max 2.8] [-
 import argparse
 import json
 import os
+import resource
 import time
 
 import numpy as np
@@ -30,6 +31,9 @@ def main():
     ap.add_argument("--steps", type=int, default=28)
     ap.add_argument("--w-max", type=float, default=2.8)
     ap.add_argument("--membrane", default="opt")
+    ap.add_argument("--extrapolate", action=argparse.BooleanOptionalAction, default=True,
+                    help="secant predictor (on the rotation group) from the last two converged steps")
+    ap.add_argument("--stability", default="auto", help="LoadControl's critical-point tracking: auto, on, off")
     args = ap.parse_args()
     out = output_dir("pullout_bench")
     t_start = time.perf_counter()
@@ -44,18 +48,27 @@ def main():
     scene.monitor("A", shell, "A")
     system = System(scene.model)
     t_setup = time.perf_counter() - t_start
-    res = dc.solve(scene, dc.LoadControl(steps=args.steps), system=system)
+    res = dc.solve(scene, dc.LoadControl(steps=args.steps, extrapolate=args.extrapolate, stability=args.stability),
+                   system=system)
     wall = comm.allreduce(time.perf_counter() - t_start, op=MPI.MAX)
     tm = system.timings
     P = 4.0 * res.history.column("A_Fz")
-    data = {"mesh": args.mesh, "membrane": args.membrane, "triangles": 2 * args.mesh[0] * args.mesh[1], "ranks": comm.size,
+    data = {"mesh": args.mesh, "membrane": args.membrane, "extrapolate": args.extrapolate, "stability": args.stability,
+            "triangles": 2 * args.mesh[0] * args.mesh[1], "ranks": comm.size,
             "steps": len(res.history), "newton_iterations": res.totals["newton_iterations"],
             "cuts": res.totals["cuts"], "wall_s": wall, "setup_s": t_setup, "assembly_s": tm.assembly,
             "solve_s": tm.solve, "update_s": tm.update,
             "other_s": wall - t_setup - tm.assembly - tm.solve - tm.update,
             "wA_at_40000": float(np.interp(40000.0, P, res.history.column("A_uz"))), "P_last": float(P[-1])}
     system.destroy()
+    rss = comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, op=MPI.SUM)
+    data["peak_rss_MB_all_ranks"] = rss
     if comm.rank == 0:
+        from summary import record
+
+        record("pullout", f"{data['triangles']} triangles ({args.membrane.upper()}), {args.steps} steps to "
+               f"w_A = {args.w_max:g}" + (", secant predictor" if args.extrapolate else ""), ranks=comm.size,
+               wall_s=wall, solver_s=wall - t_setup, peak_rss_MB=rss, newton_iterations=data["newton_iterations"])
         print(json.dumps(data, indent=1))
         with open(os.path.join(out, "bench.json"), "w") as f:
             json.dump(data, f, indent=1)

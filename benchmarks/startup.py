@@ -24,6 +24,8 @@ import subprocess
 import sys
 import time
 
+import numpy as np
+
 BEND = """
 import time
 import numpy as np
@@ -121,6 +123,19 @@ def main() -> None:
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(os.path.join(out_dir, "startup.png"), dpi=110)
+    from summary import record
+
+    from dolfinx_corot.io import reference
+
+    exact = reference("B2c_45deg_bend")["scaled_version"]["exact"]["Kirchhoff_JsaintVenant"]["data"][-1][4:7]
+    error = np.linalg.norm(np.subtract(tip, exact)) / np.linalg.norm(exact)
+    for r in rows:
+        whole = r["what"].startswith("45°")
+        record("45deg_bend" if whole else "start-up", r["what"], wall_s=r["wall_s"], peak_rss_MB=r["peak_rss_MB"],
+               solver_s=bend["in_solver_first_s"] if whole else None,
+               newton_iterations=iterations if whole else None,
+               error=f"tip {error:.2e}" if whole else "",
+               reference="exact Kirchhoff rod, reference/B2c_45deg_bend.json" if whole else "")
     print(f"{'':32s} {'wall (median)':>14s} {'/ import dolfinx':>17s} {'peak RSS':>10s}")
     for r in rows:
         print(f"{r['what']:32s} {r['wall_s']:12.3f} s {r['ratio_to_import_dolfinx']:17.2f} {r['peak_rss_MB']:7.0f} MB")

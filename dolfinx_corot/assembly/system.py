@@ -59,6 +59,7 @@ class Model(Protocol):
     def displacement_vector(self) -> PETSc.Vec: ...             # x in the layout of V (constraints)
     def update(self, dx: PETSc.Vec) -> None: ...                # x ← x ⊕ dx
     def extrapolate(self, older: object, newer: object, factor: float) -> None: ...
+    def combine(self, states: list, weights: list[float]) -> None: ...   # x = Σ wᵢ xᵢ
     def checkpoint(self) -> object: ...
     def restore(self, cp: object) -> None: ...
     def to_global(self, local: np.ndarray) -> np.ndarray | None: ...   # for checkpoint files
@@ -93,9 +94,7 @@ class System:
                  solver: str = "direct", contributions: Sequence[Contribution] = ()):
         self.model = model
         self.comm = model.comm
-        # block-compressed rows for AMG on continua: nodal blocks are inserted and multiplied
-        # several times faster than in AIJ; MUMPS gets AIJ
-        self._mat_type = "baij" if solver == "iterative" else None
+        self._mat_type = None  # AIJ (with the nodal block size): what MUMPS and AMG read
         self._build()
         self.fint, self.dx, self.step_dx, self.lift, self.fext_total, self._rhs = petsc.duplicate(self.b, 6)
         self.has_prescribed_motion = bool(model.has_prescribed_motion)
@@ -179,7 +178,7 @@ class System:
             if self._load_contributions:
                 self._add_blocks(self.fload, lambda c, add: c.add_residual(add), self._load_contributions)
             # something is near: the contributions' matrix and Newton's safeguards are needed
-            self.engaged = bool(self.comm.allreduce(any(c.engaged() for c in self.contributions), op=MPI.LOR))
+            self.engaged = bool(self._reduce(any(c.engaged() for c in self.contributions), MPI.LOR))
             self.timings.contributions += time.perf_counter() - t
 
     def _add_blocks(self, vec: PETSc.Vec, call, contributions=None) -> None:
@@ -272,11 +271,14 @@ class System:
         self.b.axpy(-1.0, self.fint)
         self._constrain_residual(load_factor)
         squares = np.zeros(6)
-        with np.errstate(over="ignore"):  # loads beyond floating point: an infinite norm, reported
-            for k, v in enumerate((self.b, self.fext_total, self.fint)):
-                a = v.array
+        for k, v in enumerate((self.b, self.fext_total, self.fint)):
+            a = v.array
+            if a.size and not np.abs(a).max() < 1e150:
+                with np.errstate(over="ignore"):  # loads beyond floating point: an infinite norm, reported
+                    squares[2 * k: 2 * k + 2] = np.bincount(self._field, a * a, 2)
+            else:
                 squares[2 * k: 2 * k + 2] = np.bincount(self._field, a * a, 2)
-        squares = self.comm.allreduce(squares, op=MPI.SUM)
+        squares = self._reduce(squares, MPI.SUM)
         norm = math.sqrt(squares[0] + squares[1])
         ref = max(math.sqrt(squares[2] + squares[3]), math.sqrt(squares[4] + squares[5]))
         # per field (forces; moments on rotational dofs), each against its own scale
@@ -289,6 +291,11 @@ class System:
                            "moment": (math.sqrt(squares[1]), max(ref_m, ell * ref_f))}
         self.timings.assembly += time.perf_counter() - t
         return norm, ref
+
+    def _reduce(self, value, op):
+        """``comm.allreduce`` of the Newton loop's small values; on one rank the value itself
+        (mpi4py's pickling allreduce costs 40 µs a call even then)."""
+        return value if self.comm.size == 1 else self.comm.allreduce(value, op=op)
 
     # -- convergence measures: fields and the round-off floor -------------------------
     def _rotation_mask(self) -> np.ndarray:
@@ -353,14 +360,14 @@ class System:
         self.A.getDiagonal(self._diagonal)
         dc = self._diagonal.array * self._coordinates  # (rotations: coordinate 1)
         eps = np.finfo(float).eps
-        sq = self.comm.allreduce(np.bincount(self._field, dc * dc, 2), op=MPI.SUM)
+        sq = self._reduce(np.bincount(self._field, dc * dc, 2), MPI.SUM)
         self.floors = {"force": eps * math.sqrt(sq[0]), "moment": eps * math.sqrt(sq[1])}
 
     def correction_norms(self) -> dict[str, tuple[float, float]]:
         """Per field: (‖dx‖, ‖Σ corrections of the step‖) — translations, rotations."""
         a, b = self.dx.array, self.step_dx.array
         sq = np.concatenate([np.bincount(self._field, a * a, 2), np.bincount(self._field, b * b, 2)])
-        sq = np.sqrt(self.comm.allreduce(sq, op=MPI.SUM))
+        sq = np.sqrt(self._reduce(sq, MPI.SUM))
         out = {"force": (sq[0], sq[2])}
         if self.has_rotations:
             out["moment"] = (sq[1], sq[3])
@@ -383,7 +390,6 @@ class System:
         self._add_contribution_tangents()
         self._constrain_matrix()
         self._update_floor()
-        self.linear.operator_changed()
         self.timings.assembly += time.perf_counter() - t
 
     def _constrain_matrix(self) -> None:
@@ -608,7 +614,7 @@ class System:
             blocks = c.correction_rhs()
             if blocks is not None:
                 extra[id(c)] = blocks
-        if not self.comm.allreduce(bool(extra), op=MPI.LOR):
+        if not self._reduce(bool(extra), MPI.LOR):
             return self.b
         self.b.copy(self._rhs)
 
@@ -657,6 +663,21 @@ class System:
         :meth:`checkpoint`)."""
         self._version += 1
         self.model.extrapolate(older[0], newer[0], factor)
+
+    def predict(self, path: list, load_factor: float) -> None:
+        """Set x to the polynomial through the converged states ``path`` [(λ, configuration of
+        :meth:`checkpoint`), …], oldest first, at ``load_factor`` (Lagrange; two states: the
+        secant, three: the parabola)."""
+        lams = [lam for lam, _ in path]
+        weights = []
+        for i, li in enumerate(lams):
+            w = 1.0
+            for j, lj in enumerate(lams):
+                if j != i:
+                    w *= (load_factor - lj) / (li - lj)
+            weights.append(w)
+        self._version += 1
+        self.model.combine([cp[0] for _, cp in path], weights)
 
     def translation_difference(self, cp_a, cp_b) -> float:
         """The largest difference of nodal translations between two configurations of

@@ -91,6 +91,13 @@ class AdditiveState:
         """x = newer + factor (newer − older)."""
         self.state.x.array[:] = newer + factor * (newer - older)
 
+    def combine(self, states: list[np.ndarray], weights: list[float]) -> None:
+        """x = Σ wᵢ xᵢ (weights summing to 1: a polynomial through converged states)."""
+        x = self.state.x.array
+        x[:] = weights[0] * states[0]
+        for w, s in zip(weights[1:], states[1:]):
+            x += w * s
+
     def displacement_vector(self) -> PETSc.Vec:
         return self.state.vector
 

@@ -41,6 +41,10 @@ class Coupled:
         for m, o, n in zip(self.models, older, newer):
             m.extrapolate(o, n, factor)
 
+    def combine(self, states, weights) -> None:
+        for i, m in enumerate(self.models):
+            m.combine([s[i] for s in states], weights)
+
     def checkpoint(self):
         return tuple(m.checkpoint() for m in self.models)
 

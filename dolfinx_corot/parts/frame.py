@@ -560,6 +560,20 @@ class Frame2D(AdditiveState, LineFrame):
 
 
 @numba.njit(cache=True)
+def _secant_quaternions(state, older, newer, f):
+    """state (n, 7) ← (u₁ + f (u₁ − u₀), exp(f log(q₁∘q₀⁻¹))∘q₁) for every node (ghosts alike:
+    their states equal their owners')."""
+    for i in range(state.shape[0]):
+        for k in range(3):
+            state[i, k] = newer[i, k] + f * (newer[i, k] - older[i, k])
+        q0 = older[i, 3:7].copy()
+        q0[1:] = -q0[1:]  # the inverse of a unit quaternion
+        w = rotations.rotvec_from_quat(rotations.quat_mul(newer[i, 3:7].copy(), q0))
+        q = rotations.quat_mul(rotations.quat_from_rotvec(f * w), newer[i, 3:7].copy())
+        state[i, 3:7] = q / np.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2 + q[3] ** 2)
+
+
+@numba.njit(cache=True)
 def _update_quaternions(state, dx, n):
     """state (n, 7) ← (u + du, exp(dw)∘q) for the first n nodes; dx (n, 6)."""
     for i in range(n):
@@ -591,8 +605,17 @@ class Rotations3D:
         self.state.x.scatter_forward()
 
     def extrapolate(self, older, newer, factor):
-        raise NotImplementedError("the secant predictor is not available for 3D rotations; "
-                                  "use LoadControl(extrapolate=False)")
+        raise NotImplementedError("states on the secant between two configurations are not formed for 3D rotations")
+
+    def combine(self, states, weights):
+        """The secant predictor on the rotation group: u = u₁ + f (u₁ − u₀) and, per node,
+        q = exp(f log(q₁∘q₀⁻¹))∘q₁ (the last converged increment of each nodal rotation, scaled
+        and applied again), with f = −w₀ of the weights (−f, 1 + f)."""
+        if len(states) != 2:
+            raise NotImplementedError("LoadControl(extrapolate='quadratic') is not available for 3D rotations; "
+                                      "use extrapolate=True (the secant on the rotation group)")
+        older, newer = (np.asarray(s).reshape(-1, NSTATE) for s in states)
+        _secant_quaternions(self.state.x.array.reshape(-1, NSTATE), older, newer, -weights[0])
 
     def displacement_vector(self) -> PETSc.Vec:
         """Displacements in the layout of the corrections (rotational entries 0), for constraints."""

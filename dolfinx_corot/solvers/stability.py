@@ -326,29 +326,37 @@ def check_first_tangent(run, load_factor: float) -> None:
 class StabilityTracker:
     """Counts the negative eigenvalues of the tangent at converged states and finds critical points.
 
-    mode: 'auto' (count with the Newton solver's LDLᵀ; with LU or an iterative solver, by an
-    LDLᵀ of the symmetric part of the converged tangent when the system has at most
-    ``max_dofs`` dofs), 'on' (always), 'off'."""
+    mode: 'auto' (count with the Newton solver's LDLᵀ; with LU, by an LDLᵀ of the symmetric
+    part of the converged tangent when the system has at most ``max_dofs`` dofs; with the
+    iterative solver, which factorizes nothing, likewise up to ``max_dofs`` in 2D but only up to
+    ``max_dofs_iterative_3d`` in 3D, where the factor's fill grows fastest: a 116 k-dof block's
+    LDLᵀ costs 10 s, twice its whole step by CG + AMG), 'on' (always), 'off'."""
 
-    def __init__(self, system, mode: str = "auto", max_dofs: int = 200_000):
+    def __init__(self, system, mode: str = "auto", max_dofs: int = 200_000,
+                 max_dofs_iterative_3d: int = 20_000):
         self.system = system
         self.mode = mode
         self.free = system.counts_inertia
         size = system.A.getSize()[0]
-        self._small = size <= max_dofs
+        limit = max_dofs
+        if getattr(system, "iterative", False) and max(m.gdim for m in system.models) == 3:
+            limit = max_dofs_iterative_3d
+        self._small = size <= limit
         self.enabled = mode == "on" or (mode == "auto" and (self.free or self._small))
         if mode == "auto" and not self.enabled:
             logger.info("critical points are not tracked: the tangent (%d dofs) is not factorized by LDLᵀ and "
-                        "counting its inertia separately would cost a factorization per step", size)
+                        "counting its inertia separately would cost a factorization per step "
+                        "(stability='on' asks for it)", size)
         self.negative: int | None = None   # at the last converged state
         self.points: list[CriticalPoint] = []
 
     def start_attempt(self) -> None:
         self.system.take_inertia()  # forget factorizations of failed attempts
 
-    def converged(self, load_factor: float) -> tuple[int | None, int | None, bool]:
+    def converged(self, load_factor: float, starts_next: bool = True) -> tuple[int | None, int | None, bool]:
         """After a converged step: (negative eigenvalues before, after, whether the Newton iterates
-        passed through a less stable region than both ends)."""
+        passed through a less stable region than both ends). starts_next: the next step starts
+        from this state (no predictor), so a factorization of its tangent here serves it."""
         if not self.enabled:
             return None, None, False
         system = self.system
@@ -374,7 +382,7 @@ class StabilityTracker:
             passed = bool(counts) and before is not None and after is not None and \
                 max(counts) > max(before, after)
         else:
-            system.tangent_at(load_factor, factorize=reusable)
+            system.tangent_at(load_factor, factorize=reusable and starts_next)
             system.take_inertia()
             after = system.inertia()
             if before is None:

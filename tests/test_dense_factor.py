@@ -1,0 +1,88 @@
+"""The dense direct solver of small serial systems (LAPACK) against numpy and against MUMPS.
+
+References: Sylvester's law of inertia (the negative eigenvalues of K are those of Bunch–Kaufman's
+block-diagonal D), the sign of det K from LU; the 45° bend (Bathe & Bolourchi 1979) solved with
+MUMPS, the solver the dense one stands in for.
+"""
+import numpy as np
+import pytest
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx_corot as dc
+import dolfinx_corot.assembly.petsc as petsc_layer
+from dolfinx_corot.assembly.petsc import DenseFactor
+from dolfinx_corot.io.mesh import from_arrays
+
+
+def _matrix(K: np.ndarray) -> PETSc.Mat:
+    n = len(K)
+    A = PETSc.Mat().createDense([n, n], comm=MPI.COMM_SELF)
+    A.setUp()
+    rows = np.arange(n, dtype=PETSc.IntType)
+    A.setValues(rows, rows, K.ravel())
+    A.assemble()
+    return A.convert("aij")
+
+
+def test_inertia_sign_and_solution_of_random_matrices():
+    """Symmetric indefinite matrices (with 2 × 2 pivots, several in a row), definite ones, and
+    matrices with zero diagonal entries: the count of negative eigenvalues, the sign of the
+    determinant and the solution equal numpy's."""
+    rng = np.random.default_rng(1)
+    for trial in range(300):
+        n = int(rng.integers(1, 40))
+        M = rng.normal(size=(n, n))
+        K = M + M.T
+        if trial % 5 == 0:
+            K = M @ M.T + 1e-3 * np.eye(n)
+        if trial % 7 == 0:  # zero diagonal: Bunch–Kaufman must pivot in 2 × 2 blocks
+            K = np.kron(np.eye((n + 1) // 2), [[0.0, 1.0], [1.0, 0.0]])[:n, :n] + 0.1 * np.diag(rng.normal(size=n))
+        f = DenseFactor(_matrix(K))
+        f.factorize(True)
+        eigenvalues = np.linalg.eigvalsh(K)
+        assert f.negative == int(np.sum(eigenvalues < 0.0)) and f.null_pivots == 0, trial
+        f.factorize(False)
+        assert f.sign == np.sign(np.linalg.det(K)), trial
+        b = PETSc.Vec().createSeq(n)
+        b.array[:] = rng.normal(size=n)
+        x = b.duplicate()
+        f.solve(b, x)
+        assert np.linalg.norm(K @ x.array - b.array) <= 1e-9 * np.linalg.norm(K) * np.linalg.norm(x.array)
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e9])
+def test_a_singular_matrix_has_a_null_pivot(scale):
+    """A free bar (a rigid translation) whatever the stiffness's units: one null pivot both ways."""
+    f = DenseFactor(_matrix(scale * np.array([[1.0, -1.0, 0.0], [-1.0, 2.0, -1.0], [0.0, -1.0, 1.0]])))
+    for ldlt in (True, False):
+        f.factorize(ldlt)
+        assert f.null_pivots == 1
+
+
+def _bend():
+    """The 45° bend, 8 co-rotational 3D beams, 20 steps (54 dofs)."""
+    R, E, nu = 100.0, 5e7, 0.2
+    phi = np.linspace(0.0, np.pi / 4, 9)
+    tm = from_arrays(np.c_[R * np.sin(phi), R * (1 - np.cos(phi)), np.zeros(9)], np.c_[np.arange(8), np.arange(1, 9)],
+                     "arc", {"base": np.array([0]), "tip": np.array([8])})
+    sc = dc.Scene(large_rotations=True)
+    arc = sc.add_beam(tm, "arc", section=dc.Section(A=1.0, I=1 / 12, Iy=1 / 12, J=0.140577),
+                      material=dc.Elastic(E, nu), orientation=(0.0, 0.0, 1.0))
+    sc.fix(arc, "base")
+    sc.load(arc, "tip", force=(0.0, 0.0, 7 * E / 12.0 / R**2))
+    sc.monitor("tip", arc, "tip")
+    return dc.solve(sc, dc.LoadControl(steps=20), quiet=True)
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="the dense path is for one rank")
+def test_the_dense_path_follows_the_path_of_mumps(monkeypatch):
+    """The bend solved densely and by MUMPS: the same Newton iterations in every step and the
+    same tip to 1e-9 of its size (round-off of two factorizations)."""
+    dense = _bend()
+    monkeypatch.setattr(petsc_layer, "DENSE_LIMIT", 0)
+    mumps = _bend()
+    assert np.array_equal(dense.history.column("iterations"), mumps.history.column("iterations"))
+    tips = [np.array([r.history.column(c)[-1] for c in ("tip_ux", "tip_uy", "tip_uz")]) for r in (dense, mumps)]
+    assert np.linalg.norm(tips[0] - tips[1]) <= 1e-9 * np.linalg.norm(tips[1])
+    assert np.linalg.norm(tips[1] - [-23.631863, -13.637087, 53.332253]) < 0.01 * np.linalg.norm(tips[1])

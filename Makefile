@@ -46,12 +46,13 @@ bench: setup
 	$(PY) benchmarks/frame3d.py --sizes 7 15 32   # 10³, 10⁴, 10⁵ elements: about 20 minutes
 	$(PY) benchmarks/block3d.py                    # 116 k dofs SVK block: about 1 minute
 	mpirun -n 2 $(PY) benchmarks/block3d.py
-	$(PY) benchmarks/block3d.py --mesh 320 32 32   # 10⁶ dofs: about 10 minutes, 8 GB
+	$(PY) benchmarks/block3d.py --mesh 320 32 32   # 10⁶ dofs: about 11 minutes, 2.2 GB
 	mpirun -n 2 $(PY) benchmarks/block3d.py --mesh 320 32 32
 	$(PY) benchmarks/contact_search.py             # 10⁴, 10⁵, 10⁶ slaves and segments
 	$(PY) benchmarks/contact_effects.py            # an idle interface's cost
 	$(PY) benchmarks/lining_soft_ground.py         # Newton iterations of contact in soft ground, three meshes
 	$(PY) benchmarks/friction.py --baseline 6245b6d^   # a block slid with friction; frictionless against the code before friction
+	@echo "the benchmarks' table: output/bench/summary.md"
 
 # numba's on-disk cache does not see edits of inlined callees in other modules
 clean-cache:

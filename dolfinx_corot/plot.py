@@ -167,10 +167,17 @@ def _grid(pv, part: dict, deformed: bool, scale: float, field: str):
     keep = np.asarray(part["exists"], dtype=bool)
     X, u = part["X"][keep], part["u"][keep]
     ncells, nv, gdim = X.shape
-    # one point per node: the cells' vertices merged where both position and displacement agree
-    # (bodies meshed apart that start in contact keep their own nodes)
+    # one point per node: the cells' vertices merged by their global node numbers (bodies meshed
+    # apart that start in contact keep their own nodes; a node's copies on several ranks are one
+    # point, though each rank computed its position with its own round-off); states without
+    # the numbers: merged where both position and displacement agree
     key = np.concatenate([X, u], axis=2).reshape(-1, 2 * gdim)
-    unique, first, connectivity = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    if part.get("keys") is not None:
+        _, first, connectivity = np.unique(np.asarray(part["keys"])[keep].ravel(), return_index=True,
+                                           return_inverse=True)
+        unique = key[first]
+    else:
+        unique, first, connectivity = np.unique(key, axis=0, return_index=True, return_inverse=True)
     connectivity = connectivity.reshape(ncells, nv)
     points = (unique[:, :gdim] + scale * unique[:, gdim:]) if deformed else unique[:, :gdim]
     if gdim == 2:

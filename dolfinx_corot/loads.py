@@ -18,7 +18,6 @@ from __future__ import annotations
 import numpy as np
 
 from .assembly.contribution import Contribution
-from .elements import follower
 
 
 class FollowerLoad:
@@ -60,6 +59,8 @@ class FollowerLoad:
         x = m.reference[self.blocks] + m.state.x.array.reshape(-1, m.state_size)[self.blocks][:, :, :g]
         if self.kind == "line2d":
             q = np.broadcast_to(self.intensity, (len(self.cells), 2))
+            from .elements import follower
+
             return follower.line2d(x, q, self.bending)
         if self.kind == "line3d":  # the element's current axes come from its nodal rotations
             n = len(self.cells)
@@ -71,6 +72,8 @@ class FollowerLoad:
                                          np.ascontiguousarray(self.bending, dtype=float), f, K)
             return f, K
         p = np.broadcast_to(self.intensity, (len(self.cells),))
+        from .elements import follower
+
         return (follower.triangle if self.kind == "triangle" else follower.quad)(x, p)
 
     def describe(self) -> dict:

@@ -11,10 +11,22 @@ import numpy as np
 from .base import Motion, Part, PartRef, global_sum, owned_dofs_of_vertices
 from .cells import MeshError
 from .coupled import Coupled
-from .frame import Frame2D, Frame3D, LineFrame
-from .shell import MembraneQuad, Shell3D, Surface3D
 from .solid import Solid
 from .surface import Surface, SurfaceError
+
+# structures come with their first use: a scene of continua alone loads neither their modules
+# nor numba (53 MB and 0.15 s)
+_LAZY = {"Frame2D": "frame", "Frame3D": "frame", "LineFrame": "frame", "MembraneQuad": "shell", "Shell3D": "shell",
+         "Surface3D": "shell"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = ["Coupled", "Frame2D", "Frame3D", "LineFrame", "MembraneQuad", "MeshError", "Motion", "Part", "PartRef", "Shell3D",
            "Solid", "Surface", "Surface3D", "SurfaceError", "global_sum", "owned_dofs_of_vertices", "part_for_mesh"]
@@ -37,7 +49,11 @@ def part_for_mesh(tmesh, large_rotations: bool, solid_degree: int | None = None)
         raise ValueError("this mesh fills its space (a continuum): use add_solid; structural parts need "
                          "lines or surfaces in space")
     if mesh.topology.dim == 2:
+        from .shell import MembraneQuad, Shell3D
+
         model = MembraneQuad if mesh.topology.cell_name() == "quadrilateral" else Shell3D
     else:
+        from .frame import Frame2D, Frame3D
+
         model = Frame3D if mesh.geometry.dim == 3 else Frame2D
     return model(tmesh, large_rotations)

@@ -117,6 +117,7 @@ class Part:
     state = None               # the configuration (a Function; made by each part)
     continuum = False          # a solid (UFL forms) rather than a structure
     coupled = False            # one mesh (Coupled: several)
+    multiplicative_rotations = False  # 3D rotations composed multiplicatively (no polynomial predictor)
     _displacement_out = None   # output Functions, made on first use
     _rotation_out = None
     symmetric_tangent = True

@@ -586,6 +586,7 @@ class Rotations3D:
     """Nodal state (u, q) with multiplicative rotation updates, shared by 3D frames and surfaces."""
 
     state_size = NSTATE
+    multiplicative_rotations = True
 
     def _init_state(self) -> None:
         S = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("Lagrange", 1), dim=NSTATE)

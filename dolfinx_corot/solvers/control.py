@@ -133,6 +133,11 @@ class LoadControl:
 
     def run(self, run: Run, restart: str | None = None) -> Result:
         system = run.system
+        if self.extrapolate == "quadratic":
+            models = system.model.models if system.model.coupled else [system.model]
+            if any(m.multiplicative_rotations for m in models):
+                raise NotImplementedError("LoadControl(extrapolate='quadratic') is not available for 3D rotations; "
+                                          "use extrapolate=True (the secant on the rotation group)")
         targets = self.targets()
         start = 0
         if restart is not None:

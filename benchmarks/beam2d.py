@@ -109,7 +109,13 @@ def main():
         f"+ update {1e3 * split['update_per_iteration_s']:.3f} ms (+ convergence checks)")
     say(f"  DOLFINx assembly of the cfunc kernels: {split['dolfinx_assembly_elements_per_s']:.3e} "
         "element evaluations per second (residual + tangent)")
+    from summary import peak_rss_MB, record
+
+    rss = peak_rss_MB(comm)
     if comm.rank == 0:
+        record("beam2d", f"cantilever of {split['elements']} 2D beams ({split['dofs']} dofs), 10 steps", ranks=comm.size,
+               wall_s=split["wall_s"], solver_s=split["wall_s"], peak_rss_MB=rss,
+               newton_iterations=split["iterations"])
         with open(os.path.join(out, "bench.json"), "w") as f:
             json.dump(data, f, indent=1)
         res.history.to_csv(os.path.join(out, "newton_steps.csv"))

@@ -81,7 +81,13 @@ def main():
             "all_times": {str(k): v for k, v in times.items()},
             "same_solution": bool(comm.rank != 0 or np.abs(u_with - u_without).max() == 0.0)}
     out = output_dir("contact_effects")
+    from summary import peak_rss_MB, record
+
+    rss = peak_rss_MB(comm)
     if comm.rank == 0:
+        for flag, name in ((False, "without interface"), (True, "with an idle interface")):
+            record("contact_effects", f"two {args.mesh[0]} × {args.mesh[1]} blocks, {name} (best of {args.repeat})",
+                   ranks=comm.size, wall_s=best[flag], solver_s=best[flag], peak_rss_MB=rss, newton_iterations=its)
         print(json.dumps(data, indent=1))
         with open(os.path.join(out, "effects.json"), "w") as f:
             json.dump(data, f, indent=1)

@@ -91,7 +91,14 @@ def main():
             f"{r['per_iteration_s']:.3f} s/iteration = assembly {r['assembly_per_iteration_s']:.3f} + solve "
             f"{r['solve_per_iteration_s']:.3f} + update {r['update_per_iteration_s']:.4f}; tangent "
             f"{r['tangent_elements_per_s']:.3g} elements/s")
+    from summary import peak_rss_MB, record
+
+    rss = peak_rss_MB(comm)
     if comm.rank == 0:
+        for r in rows:
+            record("frame3d", f"{r['elements']} 3D beams, {r['dofs']} dofs, 3 steps", ranks=comm.size,
+                   wall_s=r["wall_s"], solver_s=r["wall_s"],
+                   peak_rss_MB=rss, newton_iterations=r["iterations"])
         cols = list(rows[0])
         np.savetxt(os.path.join(out, "bench.csv"), np.array([[r[c] for c in cols] for r in rows]), delimiter=",",
                    header=",".join(cols), comments="")

@@ -80,7 +80,14 @@ def main():
         if comm.rank == 0:
             print(json.dumps(rows[-1]), flush=True)
     out = output_dir("lining_soft_ground")
+    from summary import peak_rss_MB, record
+
+    rss = peak_rss_MB(comm)
     if comm.rank == 0:
+        for r in rows:
+            record("lining_soft_ground", f"{r['hole_segments']} hole segments, {r['lining_elements']} beams, 4 steps",
+                   ranks=comm.size, wall_s=r["wall_s"], solver_s=r["wall_s"], peak_rss_MB=rss,
+                   newton_iterations=r["newton_iterations"])
         write_rows(f"{out}/iterations.csv", rows)
         with open(f"{out}/iterations.json", "w") as fh:
             json.dump({"ranks": comm.size, "rows": rows}, fh, indent=1)

@@ -34,6 +34,14 @@ def _folder() -> str:
     return path
 
 
+def peak_rss_MB(comm=None) -> float:
+    """Peak resident memory of this process so far, summed over the ranks of ``comm`` (collective)."""
+    import resource
+
+    mine = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    return mine if comm is None else comm.allreduce(mine)
+
+
 def record(benchmark: str, case: str, *, wall_s: float, solver_s: float | None = None, peak_rss_MB: float,
            newton_iterations: int | None = None, error: str = "", reference: str = "", ranks: int = 1) -> None:
     """Add (or replace) the row (benchmark, case, ranks) and rewrite the table's files."""

@@ -1,4 +1,4 @@
-"""The dense direct solver of small serial systems (LAPACK) against numpy and against MUMPS.
+"""The dense direct solver of small serial LU systems (LAPACK) against numpy and against MUMPS.
 
 References: Sylvester's law of inertia (the negative eigenvalues of K are those of Bunch–Kaufman's
 block-diagonal D), the sign of det K from LU; the 45° bend (Bathe & Bolourchi 1979) solved with

@@ -113,7 +113,7 @@ def destroy(*objects) -> None:
 
 
 # -- the linear solver ------------------------------------------------------------------
-DENSE_LIMIT = 400  # serial direct systems up to this many dofs are factorized densely (LAPACK)
+DENSE_LIMIT = 120  # serial LU systems up to this many dofs are factorized densely (LAPACK)
 NULL_PIVOT = 1e-13  # a pivot of K scaled to a unit diagonal below this is null
 
 
@@ -247,13 +247,16 @@ class LinearSolver:
         self.mumps = self.ksp.getType() == "preonly" and pc.getType() in ("lu", "cholesky") \
             and pc.getFactorSolverType() == "mumps"
         self.ldlt = self.mumps and pc.getType() == "cholesky"
-        # a small tangent on one rank is factorized densely by LAPACK: the same LDLᵀ or LU, its
-        # inertia and determinant's sign, null pivots reported alike, without MUMPS's set-up
-        # (0.6 ms of a 54-dof frame's 1 ms Newton iteration)
+        # a small tangent on one rank that is factorized by LU (3D frames and shells: their
+        # tangent is not symmetric) goes to LAPACK, and so does the LDLᵀ of its symmetric part
+        # that counts its inertia: the same determinant's sign and inertia, null pivots reported
+        # alike, without MUMPS's set-up (the 45° bend, 54 dofs: 134 → 89 ms for 100 iterations).
+        # LDLᵀ stays with MUMPS, which factorizes a banded 54-dof matrix in 0.11 ms against
+        # LAPACK's 0.19 ms (dense LU and LDLᵀ)
         self.dense: DenseFactor | None = None
         if self.mumps and comm.size == 1 and A.getSize()[0] <= DENSE_LIMIT:
             self.dense = DenseFactor(A)
-        elif self.mumps:
+        if self.mumps:
             self._mumps_controls()
         # per factorization since the last :meth:`take_inertia`: negative eigenvalues (LDLᵀ) or
         # the sign of the determinant (LU: +1 even, −1 odd)
@@ -275,9 +278,6 @@ class LinearSolver:
         for iterative solvers or when it already does."""
         if not self.mumps or bool(symmetric) == self.ldlt:
             return
-        if self.dense is not None:
-            self.ldlt = bool(symmetric)
-            return
         pc = self.ksp.getPC()
         pc.setType("cholesky" if symmetric else "lu")
         pc.setFactorSolverType("mumps")
@@ -286,7 +286,7 @@ class LinearSolver:
 
     def solve(self, rhs: PETSc.Vec, out: PETSc.Vec) -> None:
         """out = K⁻¹ rhs; raises numpy.linalg.LinAlgError for a failed solve or a singular K."""
-        if self.dense is not None:
+        if self._dense_lu():
             self._dense_factorize()
             self.dense.solve(rhs, out)
             return
@@ -342,8 +342,6 @@ class LinearSolver:
         """Number of negative eigenvalues of the last factorized tangent (LDLᵀ only; else None)."""
         if not self.ldlt:
             return None
-        if self.dense is not None:
-            return self.dense.negative
         return int(self.ksp.getPC().getFactorMatrix().getMumpsInfog(12))
 
     def factorize(self) -> None:
@@ -351,7 +349,7 @@ class LinearSolver:
         its inertia as a solve does."""
         if not self.mumps:
             return
-        if self.dense is not None:
+        if self._dense_lu():
             try:
                 self._dense_factorize()
             except np.linalg.LinAlgError:
@@ -367,20 +365,20 @@ class LinearSolver:
         else:
             self._signs.append(1 if F.getMumpsRinfog(12) >= 0.0 else -1)
 
+    def _dense_lu(self) -> bool:
+        """Whether the next factorization is LAPACK's (a small serial LU)."""
+        return self.dense is not None and not self.ldlt
+
     def _dense_factorize(self) -> None:
-        """Factorize the dense tangent when it changed since the last factorization (or the
-        choice of LDLᵀ/LU did) and note its inertia or determinant's sign, as MUMPS does at every
-        solve; raises LinAlgError for null pivots."""
+        """LU of the dense tangent when it changed since the last factorization, its determinant's
+        sign noted as MUMPS's is at every solve; raises LinAlgError for null pivots."""
         d = self.dense
-        d.factorize(self.ldlt)
+        d.factorize(False)
         if d.null_pivots:
             raise np.linalg.LinAlgError(
                 f"the tangent stiffness is singular ({d.null_pivots} zero pivot(s)): a missing support "
                 "(rigid-body motion), a mechanism, or a limit point under load control")
-        if self.ldlt:
-            self._inertia.append(d.negative)
-        else:
-            self._signs.append(d.sign)
+        self._signs.append(d.sign)
 
     def take_inertia(self) -> tuple[list[int], list[int]]:
         """(negative-eigenvalue counts, determinant signs) of the factorizations since the last call."""

@@ -57,7 +57,8 @@ class LoadControl:
 
     stability: count the negative eigenvalues of the tangent at every converged state
     ('auto': free with the LDLᵀ solver, one extra LDLᵀ factorization per step otherwise for
-    systems of up to 200 000 dofs; 'on'; 'off'; see :mod:`~dolfinx_corot.solvers.stability`);
+    systems of up to 200 000 dofs — 20 000 for 3D continua on the iterative solver; 'on';
+    'off'; see :mod:`~dolfinx_corot.solvers.stability`);
     at_critical_point: where the count changes (a bifurcation) or a step leaps across a limit
     point (its Newton iterates cross states less stable than both ends, it goes more than twice
     as far as its tangent predicted, and it still does so when followed again in halves down to

@@ -14,7 +14,6 @@ Writes output/hertz_same/{hertz_same.json, hertz_same.csv, hertz_same.png}.
 Usage: python benchmarks/hertz_same.py [--sizes 0.2 0.1 0.05]
 """
 import argparse
-import csv
 import json
 import os
 import resource
@@ -26,6 +25,7 @@ from mpi4py import MPI
 
 import dolfinx_corot as dc
 from dolfinx_corot.closed_forms import hertz_ellipse_fit
+from dolfinx_corot.io import write_rows
 from dolfinx_corot.io.mesh import name_groups
 
 comm = MPI.COMM_WORLD
@@ -109,10 +109,7 @@ def main() -> None:
         os.makedirs(out, exist_ok=True)
         with open(os.path.join(out, "hertz_same.json"), "w") as f:
             json.dump({"ranks": comm.size, "rows": rows}, f, indent=1)
-        with open(os.path.join(out, "hertz_same.csv"), "w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=list(rows[0]))
-            writer.writeheader()
-            writer.writerows(rows)
+        write_rows(os.path.join(out, "hertz_same.csv"), rows)
         from matplotlib.figure import Figure
 
         fig = Figure(figsize=(6, 4))

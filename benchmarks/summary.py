@@ -10,11 +10,12 @@ codes' figures measured side by side on this kind of machine where there are som
 """
 from __future__ import annotations
 
-import csv
 import json
 import os
 import platform
 import time
+
+from dolfinx_corot.io import write_rows
 
 COLUMNS = ["benchmark", "case", "ranks", "wall_s", "solver_s", "peak_rss_MB", "newton_iterations",
            "error", "reference", "peers", "measured"]
@@ -61,10 +62,7 @@ def record(benchmark: str, case: str, *, wall_s: float, solver_s: float | None =
     rows.sort(key=lambda r: (r["benchmark"], r["case"], r["ranks"]))
     with open(path, "w") as f:
         json.dump({"machine": f"{platform.node()} ({os.cpu_count()} cores)", "rows": rows}, f, indent=1)
-    with open(os.path.join(folder, "summary.csv"), "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS)
-        writer.writeheader()
-        writer.writerows(rows)
+    write_rows(os.path.join(folder, "summary.csv"), [{c: r[c] for c in COLUMNS} for r in rows])
     with open(os.path.join(folder, "summary.md"), "w") as f:
         f.write("| benchmark | case | ranks | wall | in the solver | peak memory | Newton its | error | peers |\n")
         f.write("|---|---|---|---|---|---|---|---|---|\n")

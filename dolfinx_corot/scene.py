@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import validate
 from .conditions import Condition
 from .contact.laws import ContactError, Penalty
 from .contact.pair import ContactPair
@@ -78,13 +79,22 @@ class Scene:
 
     LINEAR_SOLVERS = ("auto", "direct", "iterative")
 
-    def __init__(self, large_rotations: bool = True, linear_solver: str = "auto"):
+    def __init__(self, large_rotations: bool = True, linear_solver: str = "auto", tangent: str = "auto"):
         """linear_solver: 'auto' (CG + algebraic multigrid for a scene of continua only, MUMPS
         otherwise), 'direct' (MUMPS) or 'iterative'; PETSc options with the prefix
-        ``dc_newton_`` override either (e.g. ``-dc_newton_ksp_rtol 1e-12``)."""
+        ``dc_newton_`` override either (e.g. ``-dc_newton_ksp_rtol 1e-12``).
+
+        tangent: what Newton factorizes for 3D beams, shells and membranes, whose co-rotational
+        tangent is not symmetric away from equilibrium: 'auto' (its symmetric part, by LDLᵀ,
+        where the skew part vanishes at equilibrium — no applied moments, follower loads,
+        contact or stabilisation, no node with exactly one rotation held — so that Newton
+        keeps converging quadratically; the consistent tangent, by LU, otherwise), 'consistent'
+        or 'symmetrized' (see :meth:`dolfinx_corot.assembly.System.symmetrize`)."""
         if linear_solver not in self.LINEAR_SOLVERS:
             raise ValueError(f"linear_solver '{linear_solver}' is not one of {self.LINEAR_SOLVERS}")
+        validate.choice("Scene", "tangent", tangent, validate.TANGENTS)
         self.linear_solver = linear_solver
+        self.tangent = tangent
         self.large_rotations = bool(large_rotations)
         self._models: dict[int, Part] = {}
         self._coupled: Coupled | None = None

@@ -238,7 +238,8 @@ def solve_stages(scene, stages: Sequence[Stage], approach: str = "II", initial: 
                 model.set_existing(exists, reference)
         if resuming:  # each element's activation state as the checkpoint holds it (before the weights)
             memorized, mappings = resume.enter([m for m, _ in staged.values()])
-        system = make_system(scene.model, solver=scene.linear_solver, contributions=scene.contributions())
+        system = make_system(scene.model, solver=scene.linear_solver, contributions=scene.contributions(),
+                             tangent=scene.tangent)
         try:
             if resuming:  # the stage's start as the checkpoint holds it (the configuration: solve's restart)
                 start = resume.start(system)

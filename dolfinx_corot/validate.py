@@ -4,6 +4,9 @@ from __future__ import annotations
 import math
 import numbers
 
+#: what Newton factorizes for parts whose tangent is symmetric at equilibrium only (Scene, System)
+TANGENTS = ("auto", "consistent", "symmetrized")
+
 
 def whole(owner: str, name: str, value, minimum: int) -> None:
     """``value`` must be a whole number (not a bool) ≥ ``minimum``."""

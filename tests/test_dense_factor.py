@@ -60,13 +60,14 @@ def test_a_singular_matrix_has_a_null_pivot(scale):
         assert f.null_pivots == 1
 
 
-def _bend():
-    """The 45° bend, 8 co-rotational 3D beams, 20 steps (54 dofs)."""
+def _bend(tangent: str = "consistent"):
+    """The 45° bend, 8 co-rotational 3D beams, 20 steps (54 dofs); the consistent tangent (LU) by
+    default, which is what the dense path factorizes."""
     R, E, nu = 100.0, 5e7, 0.2
     phi = np.linspace(0.0, np.pi / 4, 9)
     tm = from_arrays(np.c_[R * np.sin(phi), R * (1 - np.cos(phi)), np.zeros(9)], np.c_[np.arange(8), np.arange(1, 9)],
                      "arc", {"base": np.array([0]), "tip": np.array([8])})
-    sc = dc.Scene(large_rotations=True)
+    sc = dc.Scene(large_rotations=True, tangent=tangent)
     arc = sc.add_beam(tm, "arc", section=dc.Section(A=1.0, I=1 / 12, Iy=1 / 12, J=0.140577),
                       material=dc.Elastic(E, nu), orientation=(0.0, 0.0, 1.0))
     sc.fix(arc, "base")

@@ -11,10 +11,14 @@ import sys
 
 import numpy as np
 
-__all__ = ["CCW", "NSTATE", "OnFirstUse", "RESULTANTS", "beam3d", "line2d", "membrane_quad", "shell3d"]
+__all__ = ["CCW", "NSTATE", "OnFirstUse", "RESULTANTS", "SYMMETRIZED", "beam3d", "line2d", "membrane_quad",
+           "shell3d"]
 
 #: the number of values of a node's state in 3D: displacement (3) and unit quaternion (4)
 NSTATE = 7
+#: the kernels' constant c[0] of a co-rotational analysis whose part asks for the symmetric part
+#: of the tangent, ½(K + Kᵀ) (0: geometrically linear, 1: co-rotational with K)
+SYMMETRIZED = 2.0
 #: DOLFINx's vertex order of a quadrilateral → counter-clockwise
 CCW = np.array([0, 1, 3, 2])
 #: the components of a shell's or membrane's element results (see :func:`.shell3d.resultants`)

@@ -15,7 +15,8 @@ nodal rotation; element vector (12): (u₁, w₁, u₂, w₂) with spatial spins
 DOLFINx kernels (:data:`vector_kernel`, :data:`matrix_kernel`, from
 :func:`dolfinx_corot.kernels.ufcx.tabulate_tensor_kernels`): ``w`` =
 [state node 1 (7), state node 2 (7), props (NPROPS)], ``c`` =
-[large_rotations], ``coords`` (2, 3). The residual of a co-rotational
+[mode: 0 linear, 1 co-rotational, 2 co-rotational with the symmetric part of the
+tangent], ``coords`` (2, 3). The residual of a co-rotational
 analysis needs the force only: no complex-step columns.
 """
 from __future__ import annotations
@@ -26,7 +27,8 @@ import numpy as np
 from ..corotation import frame3d
 from ..corotation.transform import force, stiffness
 from ..elements import beam3d as law
-from .spatial import H, last_node_columns, nodal_states, perturb, rotation_vector_dofs, since_activation
+from .spatial import (H, SYMMETRIZED, last_node_columns, nodal_states, perturb, rotation_vector_dofs,
+                      since_activation, symmetrize)
 from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
 NDOF = 12
@@ -232,6 +234,8 @@ def follower_loads_all(X, S, props, q, bending, f, K):
 def _tabulate(w, c, X, f, K, tangent):
     """The element function of the DOLFINx kernels (see :mod:`.ufcx`)."""
     _evaluate(X, w[:2 * NSTATE].reshape(2, NSTATE), w[2 * NSTATE:], c[0] != 0.0, tangent, f, K)
+    if tangent and c[0] == SYMMETRIZED:
+        symmetrize(K)
 
 
 vector_kernel, matrix_kernel = tabulate_tensor_kernels(_tabulate, NDOF, NCOEF, 2)
@@ -244,6 +248,8 @@ def _tabulate_staged(w, c, X, f, K, tangent):
     Xa, Sa = since_activation(X, w[:2 * NSTATE].reshape(2, NSTATE),
                               w[NCOEF:NCOEF + 2 * NSTATE].reshape(2, NSTATE))
     _evaluate(Xa, Sa, w[2 * NSTATE:NCOEF], c[0] != 0.0, tangent, f, K)
+    if tangent and c[0] == SYMMETRIZED:
+        symmetrize(K)
 
 
 # (vector_kernel, matrix_kernel) of staged elements, compiled on first use

@@ -20,7 +20,7 @@ from ..corotation import frame_quad as frame
 from ..corotation.transform import linear_force, positions, stiffness
 from ..elements import membrane_quad as law
 from . import CCW
-from .spatial import H, pack_constants, unpack_constants
+from .spatial import H, SYMMETRIZED, pack_constants, symmetrize, unpack_constants
 from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
 NNODE = 4
@@ -191,6 +191,8 @@ def _tabulate(w, c, X, f, K, tangent):
             Xc[a, k] = X[CCW[a], k]
             u[a, k] = w[NSTATE * CCW[a] + k]
     _evaluate_ccw(Xc, u, w[_E0:], c[0] != 0.0, tangent, f, K)
+    if tangent and c[0] == SYMMETRIZED:
+        symmetrize(K)
 
 
 vector_kernel, matrix_kernel = tabulate_tensor_kernels(_tabulate, NDOF, NCOEF, NNODE)
@@ -209,6 +211,8 @@ def _tabulate_staged(w, c, X, f, K, tangent):
             Xc[a, k] = X[CCW[a], k] + w[A + k]
             u[a, k] = w[NSTATE * CCW[a] + k] - w[A + k]
     _evaluate_ccw(Xc, u, w[_E0:NCOEF], c[0] != 0.0, tangent, f, K)
+    if tangent and c[0] == SYMMETRIZED:
+        symmetrize(K)
 
 
 # (vector_kernel, matrix_kernel) of staged elements, compiled on first use

@@ -19,7 +19,8 @@ vector (18): (u_a, w_a) per node with spatial spins w.
 DOLFINx kernels (:data:`vector_kernel`, :data:`matrix_kernel`, from
 :func:`dolfinx_corot.kernels.ufcx.tabulate_tensor_kernels`): ``w`` = [states
 (3 × 7), props (NPROPS), element constants (NEDATA, see :func:`element_data`)],
-``c`` = [large_rotations], ``coords`` (3, 3). The residual of a co-rotational
+``c`` = [mode: 0 linear, 1 co-rotational, 2 co-rotational with the symmetric part of the
+tangent], ``coords`` (3, 3). The residual of a co-rotational
 analysis is f = Bᵀ K̄ d̄ alone.
 """
 from __future__ import annotations
@@ -30,8 +31,8 @@ import numpy as np
 from ..corotation import frame_triangle as frame
 from ..corotation.transform import linear_force, stiffness
 from ..elements import shell_triangle as law
-from .spatial import (H, last_node_columns, nodal_states, pack_constants, perturb, rotation_vector_dofs,
-                      since_activation, unpack_constants)
+from .spatial import (H, SYMMETRIZED, last_node_columns, nodal_states, pack_constants, perturb,
+                      rotation_vector_dofs, since_activation, symmetrize, unpack_constants)
 from . import RESULTANTS  # the names of resultants()' components
 from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
@@ -248,6 +249,8 @@ def _tabulate(w, c, X, f, K, tangent):
         linear(X, S, props, edata, f, K)
     else:
         corotational_cached(X, S, props, edata, f, K, tangent)
+        if tangent and c[0] == SYMMETRIZED:
+            symmetrize(K)
 
 
 vector_kernel, matrix_kernel = tabulate_tensor_kernels(_tabulate, NDOF, NCOEF, 3)
@@ -265,6 +268,8 @@ def _tabulate_staged(w, c, X, f, K, tangent):
         linear(Xa, Sa, props, edata, f, K)
     else:
         corotational_cached(Xa, Sa, props, edata, f, K, tangent)
+        if tangent and c[0] == SYMMETRIZED:
+            symmetrize(K)
 
 
 # (vector_kernel, matrix_kernel) of staged elements, compiled on first use

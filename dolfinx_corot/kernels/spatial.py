@@ -18,6 +18,9 @@ spins w (R_a ← exp(w_a) R_a).
   updates it;
 * :func:`last_node_columns`: the six columns of the last node, exactly, from
   the others and f (translation and rotation invariance of f);
+* :func:`symmetrize`: K ← ½(K + Kᵀ), the tangent a kernel hands over when its part asks for
+  the symmetric part (``c[0]`` = :data:`dolfinx_corot.kernels.SYMMETRIZED`; see
+  :meth:`dolfinx_corot.assembly.System.symmetrize`);
 * :func:`since_activation`: an element added undeformed when its nodes' states were A
   (staged construction, approach II) sees the nodes at X + u_A and their states since then,
   (u − u_A, R R_Aᵀ); the spins are unchanged (exp(w) R R_Aᵀ), so is the tangent.
@@ -27,6 +30,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from . import SYMMETRIZED  # noqa: F401 (the kernels' c[0] asking for symmetrize)
 from ..rotations import exp_so3, log_so3, matmul3, quat_mul, quat_to_matrix
 
 H = 1e-30  # complex step
@@ -121,6 +125,17 @@ def last_node_columns(f, X, u, K):
                 e0, e1, e2 = _cross_e(k, r[a, 0], r[a, 1], r[a, 2])
                 acc -= K[i, 6 * a] * e0 + K[i, 6 * a + 1] * e1 + K[i, 6 * a + 2] * e2
             K[i, last + 3 + k] = acc
+
+
+@numba.njit(cache=True, inline="always")
+def symmetrize(K):
+    """K (n, n) ← ½(K + Kᵀ) in place."""
+    n = K.shape[0]
+    for i in range(n):
+        for j in range(i + 1, n):
+            s = 0.5 * (K[i, j] + K[j, i])
+            K[i, j] = s
+            K[j, i] = s
 
 
 @numba.njit(cache=True)

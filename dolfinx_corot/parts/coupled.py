@@ -27,6 +27,17 @@ class Coupled:
         return all(m.symmetric_tangent for m in self.models)
 
     @property
+    def symmetric_at_equilibrium(self) -> bool:
+        """Whether every model's tangent is symmetric, at least at equilibrium (see
+        :class:`~dolfinx_corot.parts.frame.Rotations3D`)."""
+        return all(m.symmetric_tangent or getattr(m, "symmetric_at_equilibrium", False) for m in self.models)
+
+    def symmetrize_tangent(self, on: bool) -> None:
+        for m in self.models:
+            if not m.symmetric_tangent:
+                m.symmetrize_tangent(on)
+
+    @property
     def has_prescribed_motion(self) -> bool:
         return any(m.has_prescribed_motion for m in self.models)
 

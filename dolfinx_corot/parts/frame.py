@@ -29,7 +29,7 @@ from ..elements import follower as follower_kernels
 from ..elements import uniform_load
 from ..io.mesh import TaggedMesh
 from ..loads import FollowerLoad
-from ..kernels import NSTATE, OnFirstUse
+from ..kernels import NSTATE, SYMMETRIZED, OnFirstUse
 from ..result import ElementResults
 from .base import AdditiveState, Part, PartRef
 from .cells import MeshError, check_geometry_degree, mesh_extent, refuse
@@ -265,13 +265,19 @@ class LineFrame(Part):
             owned = np.flatnonzero(active).astype(np.int32)
             all_owned = self.comm.allreduce(bool(len(owned) == cmap.size_local), op=MPI.LAND)
             cells = None if all_owned else owned
-            self._flag = dolfinx.fem.Constant(self.V.mesh, PETSc.ScalarType(1.0 if self.large_rotations else 0.0))
+            self._flag = dolfinx.fem.Constant(self.V.mesh, PETSc.ScalarType(self._kernel_mode()))
             coeffs = [self.state, self.props, *self._element_constants()]
             vector_kernel, matrix_kernel = self._kernel_pair()
             L = _dolfinx.kernel_form(self.V, vector_kernel.address, 1, coeffs, [self._flag], cells)
             a = _dolfinx.kernel_form(self.V, matrix_kernel.address, 2, coeffs, [self._flag], cells)
             self._forms = (L, a)
         return self._forms
+
+    _flag = None  # the kernels' constant c[0] (made with the forms)
+
+    def _kernel_mode(self) -> float:
+        """The kernels' c[0]: 0 geometrically linear, 1 co-rotational."""
+        return 1.0 if self.large_rotations else 0.0
 
     def _element_constants(self) -> list:
         """Per-cell coefficients the kernels read after the properties: the kernels' own
@@ -587,6 +593,26 @@ class Rotations3D:
 
     state_size = NSTATE
     multiplicative_rotations = True
+    # The consistent tangent with respect to spatial spins is not symmetric: its skew part is
+    # ½ spin(m_a) on each node's rotations, m_a the node's unbalanced moment sum (the bracket
+    # of the rotation group; Simo & Vu-Quoc 1986, Nour-Omid & Rankin 1991, Crisfield 1997
+    # §17.2). At equilibrium it vanishes on the free rotations wherever no moment is applied
+    # and no node has exactly one of its three rotations held (whose reaction would couple the
+    # other two): there ½(K + Kᵀ) keeps Newton's quadratic convergence and is factorized by
+    # LDLᵀ, which also counts the negative eigenvalues (see System.symmetrize)
+    symmetric_at_equilibrium = True
+    _symmetrized = False
+
+    def symmetrize_tangent(self, on: bool) -> None:
+        """The kernels return ½(K + Kᵀ) (``on``, co-rotational analyses) or K."""
+        self._symmetrized = bool(on) and self.large_rotations
+        if self._flag is not None:
+            self._flag.value = self._kernel_mode()
+
+    def _kernel_mode(self) -> float:
+        if not self.large_rotations:
+            return 0.0
+        return SYMMETRIZED if self._symmetrized else 1.0
 
     def _init_state(self) -> None:
         S = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("Lagrange", 1), dim=NSTATE)

@@ -317,7 +317,7 @@ def solve(scene, driver, system: System | None = None, on_step=None, checkpoint:
     own_system = system is None
     if own_system:
         system = make_system(scene.model, solver=scene.linear_solver,
-                             contributions=scene.contributions())
+                             contributions=scene.contributions(), tangent=scene.tangent)
     shown = Progress(mode, system.comm, label)
     try:
         return driver.run(Run(scene, system, on_step, checkpoint, attach, shown), restart)

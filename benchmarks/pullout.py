@@ -25,6 +25,22 @@ comm = MPI.COMM_WORLD
 R, L, t, E, nu = 4.953, 10.35, 0.094, 10.5e6, 0.3125
 
 
+def w_at_load(P, w, target):
+    """w_A where P = target: the root of the cubic spline P(w_A) through the converged states
+    (and the unloaded start). P stiffens sharply near 40 000 (from 32 000 to 49 000 between
+    w_A = 2.7 and 2.8), so linear interpolation between steps of 0.1 errs by −0.24 %; the
+    spline by 0.02 % with steps of 0.1 or 0.2 (against a load-controlled run ending at P)."""
+    from scipy.interpolate import CubicSpline
+    from scipy.optimize import brentq
+
+    P, w = np.r_[0.0, P], np.r_[0.0, w]
+    k = int(np.searchsorted(P, target))
+    if k == 0 or k == len(P):
+        return float("nan")
+    spline = CubicSpline(w, P)
+    return float(brentq(lambda x: spline(x) - target, w[k - 1], w[k]))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--mesh", type=int, nargs=2, default=[24, 36])
@@ -59,7 +75,7 @@ def main():
             "cuts": res.totals["cuts"], "wall_s": wall, "setup_s": t_setup, "assembly_s": tm.assembly,
             "solve_s": tm.solve, "update_s": tm.update,
             "other_s": wall - t_setup - tm.assembly - tm.solve - tm.update,
-            "wA_at_40000": float(np.interp(40000.0, P, res.history.column("A_uz"))), "P_last": float(P[-1])}
+            "wA_at_40000": w_at_load(P, res.history.column("A_uz"), 40000.0), "P_last": float(P[-1])}
     system.destroy()
     rss = comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, op=MPI.SUM)
     data["peak_rss_MB_all_ranks"] = rss

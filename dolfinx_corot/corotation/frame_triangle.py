@@ -149,7 +149,54 @@ def basic(X, u, R, R0, xbar0, dbar, B, rotations=True):
 
 
 @numba.njit(cache=True)
+def internal_force(X, u, R, R0, xbar0, Kbar, f, rotations=True):
+    """f (18,) = Λᵀ B_lᵀ K̄ d̄ (linear local law), without forming B = B_l Λ (real or complex)."""
+    dt = u.dtype
+    Rr, l, b1, b2, xbar, th, Ti, Om, Bl, dbar = parts(X, u, R, R0, xbar0, rotations)
+    fbar = np.empty(18, dtype=dt)
+    g = np.empty(18, dtype=dt)
+    linear_force(Bl, Kbar, dbar, fbar, g, 18, 18)
+    for b in range(6):
+        for k in range(3):
+            f[3 * b + k] = Rr[k, 0] * g[3 * b] + Rr[k, 1] * g[3 * b + 1] + Rr[k, 2] * g[3 * b + 2]
+
+
+@numba.njit(cache=True)
 def _dTiT_m(th, m, M):
+    """M (3, 3) = ∂(T⁻¹(θ)ᵀ m)/∂θ in closed form. With W = spin(θ), s = |θ|² and
+    T⁻¹ = I − ½W + c(s)W² (c = (1 − (t/2)cot(t/2))/t², t = |θ|):
+    T⁻ᵀm = m + ½θ × m + c v, v = θ(θ·m) − s m, so that
+    M = −½ spin(m) + c((θ·m)I + θmᵀ − 2mθᵀ) + 2c′(s) v θᵀ, with
+    c′(s) = −(cot h − h/sin²h)/(32h³) − c/s (h = t/2), or its Taylor series
+    1/720 + s/15120 + s²/403200 for s < 10⁻² (where the closed form would cancel).
+    :func:`_dTiT_m_complex_step` is the reference it is tested against."""
+    s = th[0] * th[0] + th[1] * th[1] + th[2] * th[2]
+    if s < 1e-2:
+        c = 1.0 / 12.0 + s / 720.0 + s * s / 30240.0 + s * s * s / 1209600.0
+        dc = 1.0 / 720.0 + s / 15120.0 + s * s / 403200.0
+    else:
+        h = 0.5 * np.sqrt(s)
+        sn, cs = np.sin(h), np.cos(h)
+        cot = cs / sn
+        c = (1.0 - h * cot) / s
+        dc = -(cot - h / (sn * sn)) / (32.0 * h * h * h) - c / s
+    tm = th[0] * m[0] + th[1] * m[1] + th[2] * m[2]
+    for i in range(3):
+        vi = th[i] * tm - s * m[i]
+        for j in range(3):
+            M[i, j] = c * (th[i] * m[j] - 2.0 * m[i] * th[j]) + 2.0 * dc * vi * th[j]
+        M[i, i] += c * tm
+    # −½ spin(m)
+    M[0, 1] += 0.5 * m[2]
+    M[0, 2] -= 0.5 * m[1]
+    M[1, 0] -= 0.5 * m[2]
+    M[1, 2] += 0.5 * m[0]
+    M[2, 0] += 0.5 * m[1]
+    M[2, 1] -= 0.5 * m[0]
+
+
+@numba.njit(cache=True)
+def _dTiT_m_complex_step(th, m, M):
     """M (3, 3) = ∂(T⁻¹(θ)ᵀ m)/∂θ by complex-step differentiation of a 3-vector function."""
     h = 1e-30
     thc = np.empty(3, dtype=np.complex128)

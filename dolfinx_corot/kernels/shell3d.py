@@ -29,7 +29,7 @@ import numba
 import numpy as np
 
 from ..corotation import frame_triangle as frame
-from ..corotation.transform import linear_force, stiffness
+from ..corotation.transform import stiffness
 from ..elements import shell_triangle as law
 from .spatial import (H, SYMMETRIZED, last_node_columns, nodal_states, pack_constants, perturb,
                       rotation_vector_dofs, since_activation, symmetrize, unpack_constants)
@@ -47,12 +47,7 @@ _E0 = 3 * NSTATE + law.NPROPS
 @numba.njit(cache=True)
 def _force(X, u, R, R0, xbar0, Kbar, f, rotations):
     """f (18,) = Bᵀ K̄ d̄ at the given configuration (real or complex)."""
-    dt = u.dtype
-    dbar = np.empty(18, dtype=dt)
-    B = np.empty((18, 18), dtype=dt)
-    frame.basic(X, u, R, R0, xbar0, dbar, B, rotations)
-    fbar = np.empty(18, dtype=dt)
-    linear_force(B, Kbar, dbar, fbar, f, 18, 18)
+    frame.internal_force(X, u, R, R0, xbar0, Kbar, f, rotations)
 
 
 @numba.njit(cache=True)

@@ -373,9 +373,12 @@ class StabilityTracker:
             if before is None and counts:
                 before = counts[0]  # the first tangent of the run: at the start state
             after = counts[-1] if counts else before
-            if reusable or self.mode == "on":
-                # the tangent of the converged state, factorized now, is the next step's first
-                # (with contributions, 'auto' takes the last factorization of the step instead)
+            if (reusable and (starts_next or not counts)) or self.mode == "on":
+                # the tangent of the converged state, factorized now, is the next step's first.
+                # Otherwise 'auto' takes the step's last factorization, one Newton correction
+                # short of the converged state (a count that differs there only within round-off
+                # of a critical point): with contributions, whose pairs the next solve may
+                # change, and with a predictor, where the next step starts elsewhere
                 system.tangent_at(load_factor)
                 exact, _ = system.take_inertia()
                 after = exact[-1] if exact else after

@@ -27,8 +27,8 @@ e₂·δe₃ = −ω₁). Then f = Bᵀ f̄.
 Consistent tangent (:func:`force_and_tangent`), differentiating f = Λᵀ B_lᵀ f̄ with
 f̄ = K̄ d̄: the frame turns (δΛᵀ g = Λᵀ(ω × g) blockwise), Ω changes with the
 side length l and the coordinates (b₁, b₂) of node 3, x̄_a moves, and T⁻¹(θ̄_a)
-changes with θ̄_a (its derivative contracted with the nodal moment, by complex
-step on that 3 × 3 function alone). :func:`basic` and :func:`parts` are
+changes with θ̄_a (its derivative contracted with the nodal moment, in closed
+form: :func:`_dTiT_m`). :func:`basic` and :func:`parts` are
 complex-analytic, so the closed form is checked against complex-step
 differentiation of the internal force (tests).
 """

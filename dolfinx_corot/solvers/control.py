@@ -56,7 +56,8 @@ class LoadControl:
     in its third step and loses its gain in the later ones).
 
     stability: count the negative eigenvalues of the tangent at every converged state
-    ('auto': free with the LDLᵀ solver, one extra LDLᵀ factorization per step otherwise for
+    ('auto': free with the LDLᵀ solver — with a predictor, from the step's last factorization —
+    one extra LDLᵀ factorization per step otherwise for
     systems of up to 200 000 dofs — 20 000 for 3D continua on the iterative solver; 'on';
     'off'; see :mod:`~dolfinx_corot.solvers.stability`);
     at_critical_point: where the count changes (a bifurcation) or a step leaps across a limit

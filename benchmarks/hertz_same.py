@@ -26,7 +26,7 @@ from mpi4py import MPI
 import dolfinx_corot as dc
 from dolfinx_corot.closed_forms import hertz_ellipse_fit
 from dolfinx_corot.io import write_rows
-from dolfinx_corot.io.mesh import name_groups
+from dolfinx_corot.io.mesh import name_groups, size_field
 
 comm = MPI.COMM_WORLD
 R, DEPTH, E, NU, PUSH = 8.0, 8.0, 2.0e5, 0.3, 0.1
@@ -53,9 +53,7 @@ def mesh(h: float):
         field.setNumber(2, "InField", 1)
         for key, value in (("SizeMin", h), ("SizeMax", R / 8), ("DistMin", 2.0), ("DistMax", 6.0)):
             field.setNumber(2, key, value)
-        field.setAsBackgroundMesh(2)
-        for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
-            gmsh.option.setNumber(f"Mesh.{opt}", 0)
+        size_field(2)
         name_groups({"cylinder": (2, [cyl]), "block": (2, [block]), "arc": (1, [arc]), "load": (1, [top]),
                      "axis": (1, [axis, faxis]), "block_top": (1, [ftop]), "base": (1, [fbase])})
         gmsh.model.mesh.generate(2)

@@ -77,7 +77,7 @@ from mpi4py import MPI
 
 import dolfinx_corot as dc
 from dolfinx_corot.gallery import Demo, timed
-from dolfinx_corot.io.mesh import name_groups
+from dolfinx_corot.io.mesh import name_groups, size_field
 
 comm = MPI.COMM_WORLD
 R, E, NU, MU = 1.0, 1.0, 0.3, 0.3
@@ -132,9 +132,7 @@ def mesh(h: float):
         graded(4, corners[1], R / 4, block, lines)
         field.add("Min", 7)
         field.setNumbers(7, "FieldsList", [3, 6])
-        field.setAsBackgroundMesh(7)
-        for option in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
-            gmsh.option.setNumber(f"Mesh.{option}", 0)
+        size_field(7)
         name_groups({"cylinder": (2, [cylinder]), "block": (2, [block]), "arc": (1, arcs), "top": (1, [top]),
                      "block_top": (1, lines[:2]), "base": (1, [lines[3]])})
         gmsh.model.mesh.generate(2)

@@ -56,7 +56,7 @@ import dolfinx_corot as dc
 from dolfinx_corot.closed_forms import hertz_ellipse_fit
 from dolfinx_corot.gallery import Demo, timed
 from dolfinx_corot.io import reference
-from dolfinx_corot.io.mesh import name_groups
+from dolfinx_corot.io.mesh import name_groups, size_field
 
 comm = MPI.COMM_WORLD
 ref = reference("B5_hertz_line_contact")
@@ -108,9 +108,7 @@ def mesh(h_contact: float, h_foundation: float):
         restrict(6, 4, found, [ftop, fright, fbase, faxis])
         field.add("Min", 7)
         field.setNumbers(7, "FieldsList", [5, 6])
-        field.setAsBackgroundMesh(7)
-        for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
-            gmsh.option.setNumber(f"Mesh.{opt}", 0)
+        size_field(7)
         name_groups({"cylinder": (2, [cyl]), "foundation": (2, [found]), "arc": (1, [arc]), "load": (1, [top]),
                      "axis": (1, [axis, faxis]), "foundation_top": (1, [ftop]), "base": (1, [fbase])})
         gmsh.model.mesh.generate(2)

@@ -39,7 +39,7 @@ from mpi4py import MPI
 import dolfinx_corot as dc
 from dolfinx_corot.closed_forms import hertz_ellipse_fit
 from dolfinx_corot.gallery import Demo, timed
-from dolfinx_corot.io.mesh import name_groups
+from dolfinx_corot.io.mesh import name_groups, size_field
 
 comm = MPI.COMM_WORLD
 R, E, NU, F = 10.0, 1000.0, 0.3, 300.0
@@ -84,9 +84,7 @@ def mesh(h_contact: float):
         for key, value in (("Radius", 2.0 * a), ("Thickness", 2.0 * a), ("VIn", h_contact), ("VOut", R / 3),
                            ("XCenter", 0.0), ("YCenter", 0.0), ("ZCenter", 0.0)):
             field.setNumber(ball_field, key, value)
-        field.setAsBackgroundMesh(ball_field)
-        for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
-            gmsh.option.setNumber(f"Mesh.{opt}", 0)
+        size_field(ball_field)
         name_groups(groups)
         gmsh.model.mesh.generate(3)
     tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=3, comm=comm)

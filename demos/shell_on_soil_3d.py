@@ -46,7 +46,7 @@ from mpi4py import MPI
 
 import dolfinx_corot as dc
 from dolfinx_corot.gallery import Demo, timed
-from dolfinx_corot.io.mesh import name_groups
+from dolfinx_corot.io.mesh import name_groups, size_field
 from pipe_on_soil_3d import mean_settlement  # the top's mean settlement (Betti's check)
 
 comm = MPI.COMM_WORLD
@@ -83,9 +83,7 @@ def block(h: float):
         for key, value in (("VIn", h / 2), ("VOut", h), ("XMin", 0.0), ("XMax", 1.2 * HALF), ("YMin", 0.0),
                            ("YMax", 1.2 * HALF), ("ZMin", DEPTH - 2 * HALF), ("ZMax", DEPTH), ("Thickness", HALF)):
             field.setNumber(box, key, value)
-        field.setAsBackgroundMesh(box)
-        for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
-            gmsh.option.setNumber(f"Mesh.{opt}", 0)
+        size_field(box)
         gmsh.model.mesh.generate(3)
     tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=3, comm=comm)
     if comm.rank == 0:

@@ -48,7 +48,7 @@ from mpi4py import MPI
 
 import dolfinx_corot as dc
 from dolfinx_corot.gallery import Demo, timed
-from dolfinx_corot.io.mesh import name_groups
+from dolfinx_corot.io.mesh import name_groups, size_field
 
 comm = MPI.COMM_WORLD
 E, NU, E_DIE = 100.0, 0.3, 1e4
@@ -114,9 +114,7 @@ def mesh(h_block: float, h_die: float = 0.25):
         block_only = restrict(path, block)
         both = field.add("Min")
         field.setNumbers(both, "FieldsList", [coarse, block_only])
-        field.setAsBackgroundMesh(both)
-        for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
-            gmsh.option.setNumber(f"Mesh.{opt}", 0)
+        size_field(both)
         name_groups(groups)
         gmsh.model.mesh.generate(3)
     tm = dc.from_gmsh(gmsh.model if comm.rank == 0 else None, gdim=3, comm=comm)

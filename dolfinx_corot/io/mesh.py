@@ -456,6 +456,17 @@ def name_groups(groups: dict[str, tuple[int, list[int]]]) -> None:
         gmsh.model.setPhysicalName(dim, tag, name)
 
 
+def size_field(tag: int) -> None:
+    """Make the gmsh mesh field ``tag`` the only source of element sizes of the current model:
+    its background mesh, with the sizes that gmsh otherwise takes from the boundary, the points
+    and the curvature switched off (they would override a graded field near the surfaces)."""
+    import gmsh
+
+    gmsh.model.mesh.field.setAsBackgroundMesh(tag)
+    for option in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
+        gmsh.option.setNumber(f"Mesh.{option}", 0)
+
+
 SIDES = ("bottom", "right", "top", "left")
 
 

@@ -10,6 +10,9 @@
   :mod:`dolfinx_corot.assembly.petsc` calls the two PETSc factories.
 * :func:`assemble_matrix_into`: a form's matrix added to an existing PETSc
   matrix through its current local-to-global map (no Dirichlet rows).
+* :func:`function_space`: a Lagrange or DG function space whose C++ element is made once per
+  process and element (DOLFINx 0.5.2 takes 10–100 ms to build one from its ufcx element,
+  which every space made the public way pays again).
 """
 from __future__ import annotations
 
@@ -77,3 +80,35 @@ def assemble_matrix_into(A, form) -> None:
     """A += the matrix of ``form`` (ADD_VALUES through A's local-to-global map; no Dirichlet rows)."""
     dolfinx.cpp.fem.petsc.assemble_matrix(A, form, dolfinx.fem.petsc._pack_constants(form),
                                           dolfinx.fem.petsc._pack_coefficients(form), [], True)
+
+
+# (ufl element repr) → (C++ element, address of its ufcx dofmap, the cffi module that holds both)
+_ELEMENTS: dict = {}
+
+
+def function_space(mesh: dolfinx.mesh.Mesh, family: str, degree: int, dim: int | None = None,
+                   scalar: bool = False) -> dolfinx.fem.FunctionSpace:
+    """``dolfinx.fem.VectorFunctionSpace(mesh, (family, degree), dim=dim)`` (``scalar``:
+    ``FunctionSpace(mesh, (family, degree))``), its C++ element shared by every space of the same
+    element and cell in this process: only the dofmap is made per mesh (dolfinx-0.5 notes: a
+    space from an existing C++ space is the public ``FunctionSpace(mesh, element, cppV)``). Collective."""
+    import ufl
+    from dolfinx import jit
+
+    cell = mesh.ufl_cell()
+    element = ufl.FiniteElement(family, cell, degree) if scalar else \
+        ufl.VectorElement(family, cell, degree, dim=dim)
+    key = repr(element)
+    made = _ELEMENTS.get(key)
+    if made is None:
+        (ufcx_element, ufcx_dofmap), module, _ = jit.ffcx_jit(mesh.comm, element)
+        ffi = module.ffi
+        cpp_element = dolfinx.cpp.fem.FiniteElement(ffi.cast("uintptr_t", ffi.addressof(ufcx_element)))
+        made = _ELEMENTS[key] = (cpp_element, ffi.cast("uintptr_t", ffi.addressof(ufcx_dofmap)), module)
+    cpp_element, dofmap_address, _ = made
+    dofmap = dolfinx.cpp.fem.create_dofmap(mesh.comm, dofmap_address, mesh.topology, cpp_element)
+    try:
+        cpp_space = dolfinx.cpp.fem.FunctionSpace(mesh, cpp_element, dofmap)
+    except TypeError:  # the Python Mesh wraps the C++ one
+        cpp_space = dolfinx.cpp.fem.FunctionSpace(mesh._mesh, cpp_element, dofmap)
+    return dolfinx.fem.FunctionSpace(mesh, element, cpp_space)

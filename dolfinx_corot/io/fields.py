@@ -9,6 +9,8 @@ import numpy as np
 import dolfinx.fem
 import dolfinx.io
 
+from .. import _dolfinx
+
 
 class FieldWriter:
     """Write the displacement (and the rotations, where the part has them) of every part of a
@@ -44,11 +46,11 @@ class FieldWriter:
             return
         mesh = model.V.mesh
         self.model = model
-        self.u = dolfinx.fem.Function(dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=model.gdim),
+        self.u = dolfinx.fem.Function(_dolfinx.function_space(mesh, "Lagrange", 1, model.gdim),
                                       name="displacement")
         self.cell_fields = {}
         if results and getattr(model, "section_components", ()):
-            dg0 = dolfinx.fem.FunctionSpace(mesh, ("DG", 0))
+            dg0 = _dolfinx.function_space(mesh, "DG", 0, scalar=True)
             self.cell_fields = {c: dolfinx.fem.Function(dg0, name=c) for c in model.section_components}
         # (pair, side, its surface, a scalar function on the part's nodes, its dof of each node, one at P1)
         self.pressures = []
@@ -61,7 +63,7 @@ class FieldWriter:
                     scalar, parent = model.V.sub(0).collapse()  # parent: the V dof of each scalar dof
                     at_block = np.empty(len(parent), dtype=np.int32)
                     at_block[np.asarray(parent) // model.V.dofmap.index_map_bs] = np.arange(len(parent))
-                    shown = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1)), name=name)
+                    shown = dolfinx.fem.Function(_dolfinx.function_space(mesh, "Lagrange", 1, scalar=True), name=name)
                     self.pressures.append((pair, side, surface, dolfinx.fem.Function(scalar), at_block, shown))
         self.file = dolfinx.io.XDMFFile(mesh.comm, path, "w")
         self.file.write_mesh(mesh)

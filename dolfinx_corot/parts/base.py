@@ -24,6 +24,7 @@ import dolfinx.fem
 import dolfinx.la
 import dolfinx.mesh
 
+from .. import _dolfinx
 from ..conditions import Condition
 from ..io.mesh import TaggedMesh
 from ..result import ElementResults
@@ -375,7 +376,7 @@ class Part:
             return self.state
         if self._displacement_out is None:
             self._displacement_out = dolfinx.fem.Function(
-                dolfinx.fem.VectorFunctionSpace(self.V.mesh, ("Lagrange", 1), dim=self.gdim), name="displacement")
+                _dolfinx.function_space(self.V.mesh, "Lagrange", 1, self.gdim), name="displacement")
         out = self._displacement_out
         out.x.array.reshape(-1, self.gdim)[:] = self.state.x.array.reshape(-1, self.state_size)[:, : self.gdim]
         return out
@@ -388,8 +389,7 @@ class Part:
         nr = self.ndof - self.translations
         if self._rotation_out is None:
             mesh = self.V.mesh
-            space = dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1)) if nr == 1 else \
-                dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=nr)
+            space = _dolfinx.function_space(mesh, "Lagrange", 1, nr, scalar=nr == 1)
             self._rotation_out = dolfinx.fem.Function(space, name="rotation")
         self._rotation_out.x.array[:] = self._rotation_values().ravel()
         return self._rotation_out

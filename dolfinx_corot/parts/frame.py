@@ -58,8 +58,8 @@ class LineFrame(Part):
                               "default), finer where the structure curves")
         self.tmesh = tmesh
         self.large_rotations = bool(large_rotations)
-        self.V = dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=len(self.dof_names))
-        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=self.nprops)
+        self.V = _dolfinx.function_space(mesh, "Lagrange", 1, len(self.dof_names))
+        Q = _dolfinx.function_space(mesh, "DG", 0, self.nprops)
         self.props = dolfinx.fem.Function(Q, name="section")
         self._prop_blocks = Q.dofmap.list.array  # DG0: one block per cell
         cmap = mesh.topology.index_map(self.tdim)
@@ -311,8 +311,7 @@ class LineFrame(Part):
                                       "solids, beams, bars, shells and membranes")
         if self._existing is None:
             self._existing = np.zeros(len(self._owner_of_cell), dtype=bool)
-            Q = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("DG", 0),
-                                                dim=self.nodes_per_cell * self.state_size)
+            Q = _dolfinx.function_space(self.tmesh.mesh, "DG", 0, self.nodes_per_cell * self.state_size)
             self.activation = dolfinx.fem.Function(Q, name="activation")
         self.approach = approach
         self._forms = None
@@ -615,7 +614,7 @@ class Rotations3D:
         return SYMMETRIZED if self._symmetrized else 1.0
 
     def _init_state(self) -> None:
-        S = dolfinx.fem.VectorFunctionSpace(self.tmesh.mesh, ("Lagrange", 1), dim=NSTATE)
+        S = _dolfinx.function_space(self.tmesh.mesh, "Lagrange", 1, NSTATE)
         self.state = dolfinx.fem.Function(S, name="state")
         self._reset_state()
         self._disp = dolfinx.fem.Function(self.V, name="displacement")

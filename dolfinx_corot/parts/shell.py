@@ -14,6 +14,7 @@ from mpi4py import MPI
 
 import dolfinx.fem
 
+from .. import _dolfinx
 from ..elements import membrane_quad as quad_law
 from ..elements import shell_triangle as shell_law
 from ..conditions import Condition
@@ -47,7 +48,7 @@ class Surface3D(Rotations3D, LineFrame):
         change of existence) from the cell's reference: the mesh, or where it appeared (approach II)."""
         mesh = self.tmesh.mesh
         n = self.kernels.NEDATA
-        Q = dolfinx.fem.VectorFunctionSpace(mesh, ("DG", 0), dim=n)
+        Q = _dolfinx.function_space(mesh, "DG", 0, n)
         edata = dolfinx.fem.Function(Q, name="element_constants")
         X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, self.nodes_per_cell)]
         X = X + self._activation_translations(np.arange(len(X)))

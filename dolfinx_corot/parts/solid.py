@@ -36,7 +36,7 @@ import dolfinx.fem
 import dolfinx.fem.petsc
 import dolfinx.la
 
-from .. import validate
+from .. import _dolfinx, validate
 from ..assembly import petsc
 from ..conditions import Condition
 from ..continuum.kinematics import deformation_gradient
@@ -82,12 +82,12 @@ class Solid(AdditiveState, Part):
         self.translations = self.state_size = self.gdim
         # Gauss rule: 2p on simplices, 2p + 1 on quadrilaterals/hexahedra ((p + 1)^d points)
         self.quadrature = 2 * degree + (0 if cell in ("triangle", "tetrahedron") else 1)
-        self.V = dolfinx.fem.VectorFunctionSpace(mesh, ("Lagrange", degree))
+        self.V = _dolfinx.function_space(mesh, "Lagrange", degree, mesh.geometry.dim)
         self.nodes_per_cell = self.V.dofmap.dof_layout.num_dofs  # dof blocks per cell
         self.state = dolfinx.fem.Function(self.V, name="displacement")
         self.reference_shift = dolfinx.fem.Function(self.V, name="reference_shift")
         self._shifted = None
-        Q = dolfinx.fem.FunctionSpace(mesh, ("DG", 0))
+        Q = _dolfinx.function_space(mesh, "DG", 0, scalar=True)
         self.E = dolfinx.fem.Function(Q, name="E")
         self.nu = dolfinx.fem.Function(Q, name="nu")
         self.density = dolfinx.fem.Function(Q, name="density")  # of the materials (0 where not given)
@@ -392,11 +392,10 @@ class Solid(AdditiveState, Part):
             raise NotImplementedError("staged construction of a solid whose reference was re-captured")
         if self.existing is None:
             mesh = self.V.mesh
-            self.existing = dolfinx.fem.Function(dolfinx.fem.FunctionSpace(mesh, ("DG", 0)), name="existing")
+            self.existing = dolfinx.fem.Function(_dolfinx.function_space(mesh, "DG", 0, scalar=True), name="existing")
             cell = self.V.ufl_element().cell()
             family = "DQ" if cell.cellname() in ("quadrilateral", "hexahedron") else "DG"
-            element = ufl.VectorElement(family, cell, self.degree)
-            space = dolfinx.fem.FunctionSpace(mesh, element)
+            space = _dolfinx.function_space(mesh, family, self.degree, mesh.geometry.dim)
             self.activation_shift = dolfinx.fem.Function(space, name="activation_shift")
             self.activation_reference = dolfinx.fem.Function(space, name="activation_reference")
             self._forms = None

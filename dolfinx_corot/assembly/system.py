@@ -475,10 +475,14 @@ class System:
     def skew_at_equilibrium(self) -> list[str]:
         """Why the skew part of the parts' tangent may not vanish at equilibrium (empty: it
         does). The tangent of 3D rotations with respect to spatial spins has the skew part
-        ½ spin(m) on each node's rotations, m the node's moment sum, which equilibrium makes zero
+        −½ spin(m) on each node's rotations, m the node's moment sum, which equilibrium makes zero
         on the free rotations unless a moment is applied there, or a node has exactly one of its
         three rotations held (its reaction couples the two free ones); follower loads and
-        contributions (contact, stabilising springs) add load stiffnesses of their own."""
+        contributions (contact, stabilising springs) add load stiffnesses of their own. A
+        geometrically linear analysis has K = B₀ᵀ K̄ B₀, symmetric as it is: only follower
+        loads count there."""
+        if not self.model.large_rotations:
+            return ["follower loads"] if self.fload is not None else []
         reasons = []
         if self._force_contributions:
             names = sorted({type(c).__name__ for c in self._force_contributions})
@@ -511,11 +515,12 @@ class System:
         """Symmetrize the tangent (and factorize it by LDLᵀ) as ``tangent`` asks: always for
         'symmetrized', for 'auto' where :meth:`skew_at_equilibrium` finds nothing."""
         model = self.model
-        if self.tangent == "consistent" or self.iterative or model.symmetric_tangent or not model.large_rotations \
+        if self.tangent == "consistent" or self.iterative or model.symmetric_tangent \
                 or not getattr(model, "symmetric_at_equilibrium", False):
-            if self.tangent == "symmetrized" and not self.symmetrized and not model.symmetric_tangent:
-                raise ValueError("tangent='symmetrized' is for co-rotational 3D beams, shells and membranes "
-                                 "(their tangent is symmetric at equilibrium); this model's is not")
+            if self.tangent == "symmetrized" and not model.symmetric_tangent and not self.iterative:
+                raise ValueError("tangent='symmetrized' is for 3D beams, shells and membranes (their tangent "
+                                 "is symmetric at equilibrium); this model's is not (a pressure on an open "
+                                 "surface of a solid?)")
             return
         if self.tangent == "auto" and self.linear.dense is not None:
             # a small serial system goes to LAPACK, whose LU and separate inertia count beat
@@ -541,10 +546,11 @@ class System:
 
         Where the skew part of K vanishes at equilibrium, it is of the order of the residual, so
         Newton with the symmetric part still converges quadratically, and the symmetric part is
-        what stability is judged by: LDLᵀ halves the factorization and counts the negative
-        eigenvalues with it (the pull-out of an open cylinder, 5 550 dofs: the same 111 Newton
-        iterations, the same answer to 1e-11, MUMPS 24 → 17 ms per factorization and no
-        separate LDLᵀ for the inertia)."""
+        what stability is judged by: LDLᵀ takes about two thirds of LU's time and counts the
+        negative eigenvalues with it (the pull-out of an open cylinder, 5 550 dofs: the same
+        Newton iterations within one, the same answer to 1e-14, a Newton solve 24 against 38 ms,
+        and no separate LDLᵀ of the symmetric part per step). In a geometrically linear analysis
+        the kernels' K is symmetric already and only the factorization changes."""
         self.model.symmetrize_tangent(on)
         self.symmetrized = bool(on)
         self._symmetric = bool(on) or self.model.symmetric_tangent

@@ -1,6 +1,6 @@
 """The symmetric part of the co-rotational tangent of 3D beams and shells.
 
-The consistent tangent with respect to spatial spins has the skew part ½ spin(m_a) on each
+The consistent tangent with respect to spatial spins has the skew part −½ spin(m_a) on each
 node's rotations, m_a the node's unbalanced moment sum (the bracket of the rotation group;
 Simo & Vu-Quoc 1986; Nour-Omid & Rankin 1991). At equilibrium it vanishes on the free
 rotations unless a moment is applied there or a node has exactly one rotation held. Checked

@@ -593,7 +593,7 @@ class Rotations3D:
     state_size = NSTATE
     multiplicative_rotations = True
     # The consistent tangent with respect to spatial spins is not symmetric: its skew part is
-    # ½ spin(m_a) on each node's rotations, m_a the node's unbalanced moment sum (the bracket
+    # −½ spin(m_a) on each node's rotations, m_a the node's unbalanced moment sum (the bracket
     # of the rotation group; Simo & Vu-Quoc 1986, Nour-Omid & Rankin 1991, Crisfield 1997
     # §17.2). At equilibrium it vanishes on the free rotations wherever no moment is applied
     # and no node has exactly one of its three rotations held (whose reaction would couple the

@@ -43,6 +43,7 @@ class Model(Protocol):
     V: dolfinx.fem.FunctionSpace                              # space of the Newton corrections
     state: dolfinx.fem.Function                               # the configuration (kernels' coefficient)
     symmetric_tangent: bool                                   # LDLᵀ allowed
+    symmetric_at_equilibrium: bool                            # its symmetric part may stand for K
     has_prescribed_motion: bool
     amplitudes: list                                          # distinct load amplitudes (None: ∝ λ)
     large_rotations: bool
@@ -516,7 +517,7 @@ class System:
         'symmetrized', for 'auto' where :meth:`skew_at_equilibrium` finds nothing."""
         model = self.model
         if self.tangent == "consistent" or self.iterative or model.symmetric_tangent \
-                or not getattr(model, "symmetric_at_equilibrium", False):
+                or not model.symmetric_at_equilibrium:
             if self.tangent == "symmetrized" and not model.symmetric_tangent and not self.iterative:
                 raise ValueError("tangent='symmetrized' is for 3D beams, shells and membranes (their tangent "
                                  "is symmetric at equilibrium); this model's is not (a pressure on an open "
@@ -917,7 +918,7 @@ class CoupledSystem(System):
         v.destroy()
         return any(np.any(held[loc].reshape(-1, 6)[:, 3:].sum(axis=1) == 1)
                    for m, loc in zip(self.model.models, self.layout.local)
-                   if m.ndof == 6 and getattr(m, "symmetric_at_equilibrium", False))
+                   if m.ndof == 6 and m.symmetric_at_equilibrium)
 
     def _rotation_mask(self) -> np.ndarray:
         arrays = []

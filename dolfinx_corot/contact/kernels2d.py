@@ -35,6 +35,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from ..kernels.spatial import symmetrize
+
 _H = 1e-30  # complex step
 
 
@@ -79,17 +81,6 @@ def _pair_law(N, g, multiplier, eps, a, touch, with_tangent, f_row, K_row):
             for c in range(n):
                 K_row[r, c] = a * eps * N[r] * N[c]
     return pi, 0.5 * a * pi * pi / eps, True
-
-
-@numba.njit(cache=True)
-def _symmetrize(K_row):
-    """∂²g is symmetric: remove the round-off asymmetry of its complex-step columns."""
-    n = K_row.shape[0]
-    for r in range(n):
-        for c in range(r + 1, n):
-            s = 0.5 * (K_row[r, c] + K_row[c, r])
-            K_row[r, c] = s
-            K_row[c, r] = s
 
 
 @numba.njit(cache=True)
@@ -147,7 +138,7 @@ def node_to_segment(xs, x1, x2, multiplier, penalty, area, with_tangent, touch=0
             _gap_gradient(xc, Nc)
             for r in range(6):
                 K[i, r, c] -= a * pi * Nc[r].imag / _H
-        _symmetrize(K[i])
+        symmetrize(K[i])  # ∂²g is symmetric: the complex-step columns' round-off asymmetry removed
     return g, xi, p, f, K, energy
 
 
@@ -381,7 +372,7 @@ def node_to_smooth_segment(x, side, offset, multiplier, penalty, area, with_tang
             _smooth_gap_gradient(xc, Nc, xic)
             for r in range(10):
                 K[i, r, c] -= a * pi * side[i] * Nc[r].imag / _H
-        _symmetrize(K[i])
+        symmetrize(K[i])  # ∂²g is symmetric: the complex-step columns' round-off asymmetry removed
     return g, xi, p, f, K, energy, normal
 
 

@@ -122,6 +122,9 @@ class Part:
     _displacement_out = None   # output Functions, made on first use
     _rotation_out = None
     symmetric_tangent = True
+    # a tangent that is not symmetric whose skew part vanishes at equilibrium (3D rotations): the
+    # system may factorize its symmetric part (symmetrize_tangent; see System.symmetrize)
+    symmetric_at_equilibrium = False
     kind_name = "part"
     followers: tuple = ()      # follower loads assembled as a contribution (structures)
     has_follower_loads = False  # follower loads in the part's own forms (solids)

@@ -30,7 +30,7 @@ class Coupled:
     def symmetric_at_equilibrium(self) -> bool:
         """Whether every model's tangent is symmetric, at least at equilibrium (see
         :class:`~dolfinx_corot.parts.frame.Rotations3D`)."""
-        return all(m.symmetric_tangent or getattr(m, "symmetric_at_equilibrium", False) for m in self.models)
+        return all(m.symmetric_tangent or m.symmetric_at_equilibrium for m in self.models)
 
     def symmetrize_tangent(self, on: bool) -> None:
         for m in self.models:

@@ -107,7 +107,7 @@ class Scene:
         self.stabilisers: list[Stabiliser] = []
 
     # -- parts -----------------------------------------------------------------
-    def _model(self, tmesh: TaggedMesh, solid_degree: int | None = None) -> Part:
+    def _model(self, tmesh: TaggedMesh, solid_degree: int | None = None, kind: str | None = None) -> Part:
         if not isinstance(tmesh, TaggedMesh):
             raise TypeError(f"expected a TaggedMesh from dolfinx_corot.io.from_gmsh, got {type(tmesh).__name__}")
         key = id(tmesh)
@@ -118,7 +118,7 @@ class Scene:
                     raise ValueError(f"parts of one scene live in one space: this mesh has gdim "
                                      f"{tmesh.mesh.geometry.dim}, the scene's other parts {sorted(gdims)}")
             self._coupled = None
-            self._models[key] = part_for_mesh(tmesh, self.large_rotations, solid_degree)
+            self._models[key] = part_for_mesh(tmesh, self.large_rotations, solid_degree, kind)
         model = self._models[key]
         if (solid_degree is not None) != model.continuum:
             raise ValueError("a mesh carries either a solid or structural parts, not both")
@@ -171,16 +171,22 @@ class Scene:
         return ref
 
     def add_shell(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float, material: Elastic,
-                  membrane: str = "opt", drilling: float = 1e-2) -> PartRef:
-        """Flat co-rotational shell triangles (membrane with drilling rotations + DKT bending) on
-        group ``where`` of a triangle mesh in space.
+                  membrane: str | None = None, drilling: float = 1e-2) -> PartRef:
+        """Flat co-rotational shells on group ``where`` of a triangle or quadrilateral mesh in space.
 
-        membrane: ``"opt"`` (default), Felippa's optimal ANDES triangle, whose drilling
-        rotations carry real stiffness and which bends in its plane without locking; or
-        ``"cst"``, the constant-strain triangle with a drilling penalty α·G·t·A, α = ``drilling``.
+        Triangles: membrane with drilling rotations + DKT bending (Kirchhoff). membrane:
+        ``"opt"`` (the default), Felippa's optimal ANDES triangle, whose drilling rotations carry
+        real stiffness and which bends in its plane without locking; or ``"cst"``, the
+        constant-strain triangle with a drilling penalty α·G·t·A, α = ``drilling``.
+
+        Quadrilaterals (possibly warped): the bilinear membrane with incompatible modes (QM6, no
+        locking in in-plane bending) and a drilling penalty ½·α·G·t∫(θz − ω)²dA, MITC4 bending and
+        transverse shear (Reissner–Mindlin, shear factor 5/6, free of shear locking); membrane
+        ``"qm6"`` or None. A quadrilateral mesh given shells carries its membranes with the same
+        element (add its shells first).
         """
         self._check_material("shell", where, material)
-        model = self._model(tmesh)
+        model = self._model(tmesh, kind="shell")
         ref = model.add_shell(where, material.E, material.nu, float(thickness), float(drilling), membrane)
         model.set_mass(ref, material.density, float(thickness))
         return ref
@@ -188,8 +194,9 @@ class Scene:
     def add_membrane(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float,
                      material: Elastic) -> PartRef:
         """Co-rotational membranes (in-plane stiffness only) on group ``where`` of a triangle
-        (constant-strain triangles) or quadrilateral (bilinear Q4) mesh in space; nodes
-        carried by membranes alone have their rotations fixed."""
+        (constant-strain triangles) or quadrilateral mesh in space (bilinear Q4; on a mesh that also
+        carries shells, the shell's membrane with incompatible modes); nodes carried by membranes
+        alone have their rotations fixed."""
         self._check_material("membrane", where, material)
         model = self._model(tmesh)
         ref = model.add_membrane(where, material.E, material.nu, float(thickness))

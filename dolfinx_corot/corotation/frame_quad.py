@@ -33,8 +33,11 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..rotations import cross, dot
-from .transform import frame_axes, local_coordinates, positions
+from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
+from .frame_triangle import _dTiT_m
+from .transform import frame_axes, linear_force, local_coordinates, positions, rotate_columns, stiffness
+
+H = 1e-30  # complex step of the frame spin's variation
 
 
 @numba.njit(cache=True)
@@ -120,3 +123,226 @@ def basic(X, u, xbar0, dbar, B):
             # δū = Rᵀ(δu_a − δu_c) + x̄_a × ω, rows x and y
             B[2 * a, col] = coef * R[k, 0] + xa[1] * o2 - xa[2] * o1
             B[2 * a + 1, col] = coef * R[k, 1] + xa[2] * o0 - xa[0] * o2
+
+
+# -- four-node shells: nodal rotations as well -------------------------------------------------
+#
+# The same frame; the deformational rotations θ̄_a = log(R_rᵀ R_a R_0) and the variations in local
+# components (d^l = Λd, Λ = blockdiag(R_rᵀ)), 6 dofs per node:
+#     δū_a = δu_a − δu_c + x̄_a × ω,   δθ̄_a = T⁻¹(θ̄_a)(δw_a − ω),   ω = Ω(x̄) δu^l,
+# as for the triangle (:mod:`.frame_triangle`). Ω depends on the element's shape alone, so its
+# variation contracted with a vector, ∂(Ωᵀv)/∂x̄, is taken by complex step of :func:`shape_spin`
+# (12 evaluations of a few cross products) in :func:`shell_force_and_tangent`.
+
+
+@numba.njit(cache=True)
+def shape_spin(y, Om):
+    """Om (3, 24): the frame spin in the frame's own axes, ω = Ω δd^l, for nodes at y (4, 3) and
+    variations δd^l (6 per node) in the frame's components. A function of the shape of y alone
+    (invariant under rigid motions of y), complex-analytic."""
+    dt = y.dtype
+    R = np.empty((3, 3), dtype=dt)
+    frame(y, R)
+    d1 = y[2] - y[0]
+    d2 = y[3] - y[1]
+    n = np.empty(3, dtype=dt)
+    cross(d1, d2, n)
+    nn = np.sqrt(dot(n, n))
+    l1 = np.sqrt(dot(d1, d1))
+    l2 = np.sqrt(dot(d2, d2))
+    h1 = d1 / l1
+    h2 = d2 / l2
+    m = h1 - h2
+    mm = np.sqrt(dot(m, m))
+    e1 = R[:, 0].copy()
+    e2 = R[:, 1].copy()
+    p1 = np.empty(3, dtype=dt)
+    p2 = np.empty(3, dtype=dt)
+    q1 = np.empty(3, dtype=dt)
+    q2 = np.empty(3, dtype=dt)
+    cross(d2, e2, p1)
+    cross(e2, d1, p2)
+    cross(d2, e1, q1)
+    cross(e1, d1, q2)
+    s1 = (e2 - dot(e2, h1) * h1) / l1
+    s2 = -(e2 - dot(e2, h2) * h2) / l2
+    # rows of ω against the global δd1 = δu3 − δu1, δd2 = δu4 − δu2, then turned to local columns
+    g = np.empty((3, 2, 3), dtype=dt)
+    for k in range(3):
+        g[0, 0, k] = -p1[k] / nn
+        g[0, 1, k] = -p2[k] / nn
+        g[1, 0, k] = q1[k] / nn
+        g[1, 1, k] = q2[k] / nn
+        g[2, 0, k] = s1[k] / mm
+        g[2, 1, k] = s2[k] / mm
+    for i in range(3):
+        for c in range(24):
+            Om[i, c] = 0.0
+        for s in range(2):
+            for k in range(3):
+                acc = g[i, s, 0] * R[0, k] + g[i, s, 1] * R[1, k] + g[i, s, 2] * R[2, k]
+                # d1: nodes 3 (+) and 1 (−); d2: nodes 4 (+) and 2 (−)
+                Om[i, 6 * (2 + s) + k] += acc
+                Om[i, 6 * s + k] -= acc
+
+
+@numba.njit(cache=True)
+def shell_parts(X, u, R, R0, xbar0):
+    """(R_r, x̄ (4, 3), θ̄ (4, 3), T⁻¹(θ̄_a) (4, 3, 3), Ω (3, 24), B_l (24, 24), d̄ (24,)) of a
+    four-node shell: X (4, 3) initial nodes counter-clockwise, u (4, 3) displacements, R (4, 3, 3)
+    nodal rotations, R0 and x̄0 from :func:`initial`; δd̄ = B_l δd^l. Complex-analytic."""
+    dt = u.dtype
+    x = positions(X, u)
+    Rr = np.empty((3, 3), dtype=dt)
+    frame(x, Rr)
+    xbar = np.empty((4, 3), dtype=dt)
+    local_coordinates(Rr, x, xbar)
+    R0c = np.empty((3, 3), dtype=dt)
+    for i in range(3):
+        for j in range(3):
+            R0c[i, j] = R0[i, j]
+    T = np.empty((3, 3), dtype=dt)
+    Rb = np.empty((3, 3), dtype=dt)
+    Ra = np.empty((3, 3), dtype=dt)
+    th = np.zeros((4, 3), dtype=dt)
+    Ti = np.zeros((4, 3, 3), dtype=dt)
+    dbar = np.empty(24, dtype=dt)
+    for a in range(4):
+        for i in range(3):
+            for j in range(3):
+                Ra[i, j] = R[a, i, j]
+        matmul3_tn(Rr, Ra, T)
+        matmul3(T, R0c, Rb)
+        log_so3(Rb, th[a])
+        tangent_inv_so3(th[a], Ti[a])
+        for k in range(3):
+            dbar[6 * a + k] = xbar[a, k] - xbar0[a, k]
+            dbar[6 * a + 3 + k] = th[a, k]
+    Om = np.empty((3, 24), dtype=dt)
+    shape_spin(xbar, Om)
+    Bl = np.zeros((24, 24), dtype=dt)
+    for a in range(4):
+        for k in range(3):
+            for b in range(4):
+                Bl[6 * a + k, 6 * b + k] -= 0.25
+            Bl[6 * a + k, 6 * a + k] += 1.0
+        xa = xbar[a]
+        for col in range(24):
+            o0, o1, o2 = Om[0, col], Om[1, col], Om[2, col]
+            Bl[6 * a + 0, col] += xa[1] * o2 - xa[2] * o1
+            Bl[6 * a + 1, col] += xa[2] * o0 - xa[0] * o2
+            Bl[6 * a + 2, col] += xa[0] * o1 - xa[1] * o0
+        Tia = Ti[a]
+        for r in range(3):
+            for col in range(24):
+                Bl[6 * a + 3 + r, col] -= Tia[r, 0] * Om[0, col] + Tia[r, 1] * Om[1, col] + Tia[r, 2] * Om[2, col]
+            for k in range(3):
+                Bl[6 * a + 3 + r, 6 * a + 3 + k] += Tia[r, k]
+    return Rr, xbar, th, Ti, Om, Bl, dbar
+
+
+@numba.njit(cache=True)
+def shell_basic(X, u, R, R0, xbar0, dbar, B):
+    """d̄ (24,) and B = ∂d̄/∂d = B_l Λ (24, 24) of a four-node shell (see :func:`shell_parts`)."""
+    Rr, xbar, th, Ti, Om, Bl, d = shell_parts(X, u, R, R0, xbar0)
+    for r in range(24):
+        dbar[r] = d[r]
+    rotate_columns(Bl, Rr, B, 24, 24)
+
+
+@numba.njit(cache=True)
+def shell_force(X, u, R, R0, xbar0, Kbar, f):
+    """f (24,) = Λᵀ B_lᵀ K̄ d̄ of a four-node shell (real or complex)."""
+    dt = u.dtype
+    Rr, xbar, th, Ti, Om, Bl, dbar = shell_parts(X, u, R, R0, xbar0)
+    fbar = np.empty(24, dtype=dt)
+    g = np.empty(24, dtype=dt)
+    linear_force(Bl, Kbar, dbar, fbar, g, 24, 24)
+    for b in range(8):
+        for k in range(3):
+            f[3 * b + k] = Rr[k, 0] * g[3 * b] + Rr[k, 1] * g[3 * b + 1] + Rr[k, 2] * g[3 * b + 2]
+
+
+@numba.njit(cache=True)
+def shell_force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K):
+    """f = Bᵀ K̄ d̄ and its consistent tangent K = ∂f/∂d of a four-node shell.
+
+    In local components, with g = B_lᵀ f̄ and v = Σ_a(n_a × x̄_a − T_a⁻ᵀ m_a) (n_a, m_a the
+    local nodal forces and moments):
+    K^l = B_lᵀ K̄ B_l − S(g) Ω + Σ_a ∂(Ωᵀv)/∂x̄_a B_{u,a}
+          + Ωᵀ Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) + Σ_a E_aᵀ M_a B_{θ,a},
+    M_a = ∂(T⁻¹(θ̄_a)ᵀ m_a)/∂θ̄_a in closed form (:func:`frame_triangle._dTiT_m`), ∂(Ωᵀv)/∂x̄
+    by complex step of :func:`shape_spin`; K = Λᵀ K^l Λ and f = Λᵀ g. The derivation is the
+    triangle's (:func:`.frame_triangle.force_and_tangent`); only Ω differs."""
+    Rr, xbar, th, Ti, Om, Bl, dbar = shell_parts(X, u, R, R0, xbar0)
+    fbar = np.empty(24)
+    g = np.empty(24)
+    linear_force(Bl, Kbar, dbar, fbar, g, 24, 24)
+    Kl = np.empty((24, 24))
+    stiffness(Bl, Kbar, Kl, 24, 24)
+    for b in range(8):
+        g0, g1, g2 = g[3 * b], g[3 * b + 1], g[3 * b + 2]
+        for col in range(24):
+            o0, o1, o2 = Om[0, col], Om[1, col], Om[2, col]
+            Kl[3 * b + 0, col] -= g1 * o2 - g2 * o1
+            Kl[3 * b + 1, col] -= g2 * o0 - g0 * o2
+            Kl[3 * b + 2, col] -= g0 * o1 - g1 * o0
+    v = np.zeros(3)
+    M = np.zeros((4, 3, 3))
+    for a in range(4):
+        n0, n1, n2 = fbar[6 * a], fbar[6 * a + 1], fbar[6 * a + 2]
+        xa = xbar[a]
+        v[0] += n1 * xa[2] - n2 * xa[1]
+        v[1] += n2 * xa[0] - n0 * xa[2]
+        v[2] += n0 * xa[1] - n1 * xa[0]
+        m = fbar[6 * a + 3:6 * a + 6].copy()
+        for i in range(3):
+            v[i] -= Ti[a, 0, i] * m[0] + Ti[a, 1, i] * m[1] + Ti[a, 2, i] * m[2]
+        _dTiT_m(th[a], m, M[a])
+    # Σ_a ∂(Ωᵀv)/∂x̄_a B_{u,a}: J (24, 12) by complex step of Ω(y) at y = x̄
+    yc = np.empty((4, 3), dtype=np.complex128)
+    Omc = np.empty((3, 24), dtype=np.complex128)
+    J = np.empty((24, 12))
+    for j in range(12):
+        for a in range(4):
+            for k in range(3):
+                yc[a, k] = xbar[a, k]
+        yc[j // 3, j % 3] += 1j * H
+        shape_spin(yc, Omc)
+        for i in range(24):
+            J[i, j] = (Omc[0, i] * v[0] + Omc[1, i] * v[1] + Omc[2, i] * v[2]).imag / H
+    for i in range(24):
+        for j in range(24):
+            acc = 0.0
+            for a in range(4):
+                for k in range(3):
+                    acc += J[i, 3 * a + k] * Bl[6 * a + k, j]
+            Kl[i, j] += acc
+    W = np.zeros((3, 24))
+    for a in range(4):
+        n0, n1, n2 = fbar[6 * a], fbar[6 * a + 1], fbar[6 * a + 2]
+        for j in range(24):
+            t0, t1, t2 = Bl[6 * a, j], Bl[6 * a + 1, j], Bl[6 * a + 2, j]
+            W[0, j] += n1 * t2 - n2 * t1
+            W[1, j] += n2 * t0 - n0 * t2
+            W[2, j] += n0 * t1 - n1 * t0
+            r0, r1, r2 = Bl[6 * a + 3, j], Bl[6 * a + 4, j], Bl[6 * a + 5, j]
+            for i in range(3):
+                MB = M[a, i, 0] * r0 + M[a, i, 1] * r1 + M[a, i, 2] * r2
+                W[i, j] -= MB
+                Kl[6 * a + 3 + i, j] += MB
+    for i in range(24):
+        o0, o1, o2 = Om[0, i], Om[1, i], Om[2, i]
+        if o0 != 0.0 or o1 != 0.0 or o2 != 0.0:
+            for j in range(24):
+                Kl[i, j] += o0 * W[0, j] + o1 * W[1, j] + o2 * W[2, j]
+    for b in range(8):
+        for k in range(3):
+            f[3 * b + k] = Rr[k, 0] * g[3 * b] + Rr[k, 1] * g[3 * b + 1] + Rr[k, 2] * g[3 * b + 2]
+    tmp = np.empty((24, 24))
+    rotate_columns(Kl, Rr, tmp, 24, 24)
+    for br in range(8):
+        for k in range(3):
+            for j in range(24):
+                K[3 * br + k, j] = (Rr[k, 0] * tmp[3 * br, j] + Rr[k, 1] * tmp[3 * br + 1, j]
+                                    + Rr[k, 2] * tmp[3 * br + 2, j])

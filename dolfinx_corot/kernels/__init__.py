@@ -12,7 +12,7 @@ import sys
 import numpy as np
 
 __all__ = ["CCW", "NSTATE", "OnFirstUse", "RESULTANTS", "SYMMETRIZED", "beam3d", "line2d", "membrane_quad",
-           "shell3d"]
+           "shell3d", "shell_quad"]
 
 #: the number of values of a node's state in 3D: displacement (3) and unit quaternion (4)
 NSTATE = 7
@@ -43,6 +43,6 @@ class OnFirstUse:
 
 
 def __getattr__(name: str):
-    if name in ("beam3d", "line2d", "membrane_quad", "shell3d"):
+    if name in ("beam3d", "line2d", "membrane_quad", "shell3d", "shell_quad"):
         return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -17,7 +17,7 @@ from .surface import Surface, SurfaceError
 # structures come with their first use: a scene of continua alone loads neither their modules
 # nor numba (53 MB and 0.15 s)
 _LAZY = {"Frame2D": "frame", "Frame3D": "frame", "LineFrame": "frame", "MembraneQuad": "shell", "Shell3D": "shell",
-         "Surface3D": "shell"}
+         "ShellQuad": "shell", "Surface3D": "shell"}
 
 
 def __getattr__(name: str):
@@ -29,13 +29,14 @@ def __getattr__(name: str):
 
 
 __all__ = ["Coupled", "Frame2D", "Frame3D", "LineFrame", "MembraneQuad", "MeshError", "Motion", "Part", "PartRef", "Shell3D",
-           "Solid", "Surface", "Surface3D", "SurfaceError", "global_sum", "owned_dofs_of_vertices", "part_for_mesh"]
+           "ShellQuad", "Solid", "Surface", "Surface3D", "SurfaceError", "global_sum", "owned_dofs_of_vertices", "part_for_mesh"]
 
 
-def part_for_mesh(tmesh, large_rotations: bool, solid_degree: int | None = None) -> Part:
+def part_for_mesh(tmesh, large_rotations: bool, solid_degree: int | None = None, kind: str | None = None) -> Part:
     """The part model of a mesh: a solid (``solid_degree`` given) or the structure its cells carry
     (lines: 2D or 3D frames; triangles in space: shells and membranes; quadrilaterals in space:
-    membranes)."""
+    shells and membranes when ``kind`` is ``"shell"`` (the first elements asked for), membranes
+    alone otherwise)."""
     mesh = tmesh.mesh
     x = mesh.geometry.x
     bad = np.flatnonzero(~np.isfinite(x).all(axis=1))
@@ -49,9 +50,12 @@ def part_for_mesh(tmesh, large_rotations: bool, solid_degree: int | None = None)
         raise ValueError("this mesh fills its space (a continuum): use add_solid; structural parts need "
                          "lines or surfaces in space")
     if mesh.topology.dim == 2:
-        from .shell import MembraneQuad, Shell3D
+        from .shell import MembraneQuad, Shell3D, ShellQuad
 
-        model = MembraneQuad if mesh.topology.cell_name() == "quadrilateral" else Shell3D
+        if mesh.topology.cell_name() == "quadrilateral":
+            model = ShellQuad if kind == "shell" else MembraneQuad
+        else:
+            model = Shell3D
     else:
         from .frame import Frame2D, Frame3D
 

@@ -2,7 +2,10 @@
 
 * :class:`Shell3D`: flat co-rotational shell triangles (OPT or CST membrane with drilling
   rotations, DKT bending) and membrane triangles on a triangle mesh;
-* :class:`MembraneQuad`: four-node co-rotational membranes on a quadrilateral mesh.
+* :class:`ShellQuad`: four-node co-rotational shells (incompatible-mode membrane with drilling
+  rotations, MITC4 bending and transverse shear) and membranes on a quadrilateral mesh;
+* :class:`MembraneQuad`: four-node co-rotational membranes (bilinear Q4) on a quadrilateral mesh
+  that carries no shells.
 
 Both have 6 dofs per node (u, spatial spins) with multiplicative rotations as 3D frames,
 so that they share nodes with beams.
@@ -16,6 +19,7 @@ import dolfinx.fem
 
 from .. import _dolfinx
 from ..elements import membrane_quad as quad_law
+from ..elements import shell_quad as quad_shell_law
 from ..elements import shell_triangle as shell_law
 from ..conditions import Condition
 from ..io.mesh import TaggedMesh
@@ -140,14 +144,15 @@ class Shell3D(Surface3D):
                                       "cells (set Mesh.RecombineAll = 0 in gmsh)")
         super().__init__(tmesh, large_rotations)
 
-    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str = "opt"):
+    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str | None = None):
         label = f"shell '{where}'"
         if not (thickness > 0.0 and np.isfinite(thickness)):
             raise ValueError(f"{label}: thickness = {thickness} must be positive")
         if not drilling > 0.0:
             raise ValueError(f"{label}: the drilling factor {drilling} must be positive")
+        membrane = "opt" if membrane is None else membrane
         if membrane not in ("opt", "cst"):
-            raise ValueError(f"{label}: membrane '{membrane}' is not one of ('opt', 'cst')")
+            raise ValueError(f"{label}: membrane '{membrane}' is not one of the triangles' ('opt', 'cst')")
         opt = 1.0 if membrane == "opt" else 0.0
         return self.add_elements(where, np.array([E, nu, thickness, drilling, 1.0, opt]), True, "shell")
 
@@ -164,6 +169,44 @@ class Shell3D(Surface3D):
         refuse(mesh, label, [(problem, cells[bad]) for problem, bad in problems])
 
 
+class ShellQuad(Surface3D):
+    """Four-node co-rotational shells on a quadrilateral mesh in space (see
+    :mod:`dolfinx_corot.kernels.shell_quad`); dofs (ux, uy, uz, rx, ry, rz) per node, rotations
+    multiplicative as in :class:`Frame3D`. Membranes on the same mesh are the shell element's
+    membrane alone (incompatible modes, no drilling, bending or shear stiffness); nodes carried by
+    membranes alone have their rotations fixed."""
+
+    nodes_per_cell = 4
+    nprops = quad_shell_law.NPROPS
+    kernels = OnFirstUse("shell_quad")
+
+    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str | None = None):
+        label = f"shell '{where}'"
+        quad_law.check_props(E, nu, thickness, label)
+        if not (drilling > 0.0 and np.isfinite(drilling)):
+            raise ValueError(f"{label}: the drilling factor {drilling} must be positive")
+        if membrane not in (None, "qm6"):
+            raise ValueError(f"{label}: membrane '{membrane}' is for triangles; a quadrilateral shell's membrane is "
+                             "'qm6' (bilinear with incompatible modes)")
+        props = quad_shell_law.isotropic_props(E, nu, thickness, drilling)
+        return self.add_elements(where, props, True, "shell")
+
+    def add_membrane(self, where, E: float, nu: float, thickness: float):
+        quad_law.check_props(E, nu, thickness, f"membrane '{where}'")
+        props = quad_shell_law.isotropic_props(E, nu, thickness, 0.0)
+        props[quad_shell_law.D0:] = 0.0  # no bending, no transverse shear
+        return self.add_elements(where, props, False, "membrane")
+
+    def _check_geometry(self, cells, label, props):
+        """Refuse quadrilaterals of zero size or area, self-intersecting, not convex, with three
+        corners on a line or strongly warped (MeshError naming the first; see
+        :func:`dolfinx_corot.parts.cells.quadrilateral_problems`)."""
+        mesh = self.tmesh.mesh
+        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 4)[cells][:, CCW]]
+        problems = quadrilateral_problems(X, mesh_extent(mesh))
+        refuse(mesh, label, [(problem, cells[bad]) for problem, bad in problems])
+
+
 class MembraneQuad(Surface3D):
     """Four-node co-rotational membranes on a quadrilateral mesh in space; dofs (ux, uy, uz, rx,
     ry, rz) per node like shells (so that they may share nodes with shells and beams), the
@@ -174,9 +217,9 @@ class MembraneQuad(Surface3D):
     kernels = OnFirstUse("membrane_quad")
 
     def add_shell(self, where, E, nu, thickness, drilling, membrane) -> PartRef:
-        raise NotImplementedError(f"shell '{where}': shells are triangles; this mesh has quadrilaterals, which "
-                                  "carry membranes (add_membrane). Mesh the shell with triangles "
-                                  "(gmsh: Mesh.RecombineAll = 0)")
+        raise ValueError(f"shell '{where}': this quadrilateral mesh was given membranes first, which made it a "
+                         "part of membranes alone (bilinear Q4); add its shells before its membranes, so that "
+                         "the mesh carries four-node shells and its membranes are the shell's membrane")
 
     def add_membrane(self, where, E: float, nu: float, thickness: float):
         quad_law.check_props(E, nu, thickness, f"membrane '{where}'")

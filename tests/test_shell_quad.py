@@ -256,7 +256,8 @@ def _strip(nx, L=12.0, b=1.0, comm=None):
 def test_strip_rolls_into_a_circle():
     """A strip L = 12, b = 1, t = 0.1, ν = 0 of 16 quadrilaterals rolled into a full circle by an
     end moment M = 2πEI/L in 30 steps (benchmark B2a, closed form): the tip at every step within
-    2e-3 L of the closed form, back at (−L, 0) to 1e-6 L, no cut step."""
+    2e-3 L of the closed form, back at (−L, 0) to 1e-6 L, no cut step; every cell's resultants
+    are the moment M/b (0.5 %) and nothing else."""
     L, b, t, E_ = 12.0, 1.0, 0.1, 1.2e6
     EI = E_ * b * t**3 / 12
     sc = dc.Scene()
@@ -271,6 +272,12 @@ def test_strip_rolls_into_a_circle():
                    np.array(h.column("tip_uz_mean")) - L * (1 - np.cos(phi)) / phi) / L
     assert err.max() < 2e-3 and err[-1] < 1e-6
     assert result.totals["cuts"] == 0
+    # every cell carries the end moment per unit width about its width axis, and nothing else
+    r = sc.element_results(s)
+    assert r.values.shape == (16, 1, 16)
+    np.testing.assert_allclose(np.abs(r["Mxx"][:, 0]), 2 * np.pi * EI / L / b, rtol=5e-3)
+    for name in ("Nxx", "Nyy", "Nxy", "Myy", "Mxy", "Qx", "Qy"):
+        assert np.abs(r[name][:, 0]).max() < 1e-3 * 2 * np.pi * EI / L
 
 
 def test_quadrilateral_shells_refuse_what_they_cannot_do():

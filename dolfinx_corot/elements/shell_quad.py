@@ -235,8 +235,8 @@ def centre_resultants(xbar0, props, dbar, out):
     S = props[S0:S0 + 4].copy().reshape(2, 2)
     _, _, J0, det0 = shape(xy, 0.0, 0.0)
     Be, Bk, _, _, _ = _strains(xy, 0.0, 0.0, J0, det0)
-    eps = Be[:, :24] @ d
-    kap = Bk[:, :24] @ d
+    eps = np.ascontiguousarray(Be[:, :24]) @ d
+    kap = np.ascontiguousarray(Bk[:, :24]) @ d
     out[0:3] = A @ eps + Bc @ kap
     out[3:6] = Bc @ eps + D @ kap
     Bs = _shear_tied(xy, 0.0, 0.0)

@@ -48,8 +48,9 @@ def polyline(points: Sequence[Sequence[float]], elements_per_segment: int | Sequ
 
 
 def cylinder_eighth(radius: float, length: float, n_theta: int, n_x: int,
-                    comm: MPI.Comm = MPI.COMM_WORLD) -> TaggedMesh:
-    """One eighth of an open cylinder (axis x), structured triangles, for pull-out problems.
+                    comm: MPI.Comm = MPI.COMM_WORLD, quads: bool = False) -> TaggedMesh:
+    """One eighth of an open cylinder (axis x), structured triangles (quadrilaterals with
+    ``quads``: n_theta × n_x of them), for pull-out problems.
 
     x ∈ [0, length/2], θ ∈ [0, 90°] measured from the z axis towards y. Groups:
     'shell' (surface), 'mid' (edge on x = 0), 'top' (edge on y = 0), 'side'
@@ -72,6 +73,8 @@ def cylinder_eighth(radius: float, length: float, n_theta: int, n_x: int,
         for line, n in ((mid, n_theta), (free, n_theta), (top, n_x), (side, n_x)):
             gmsh.model.mesh.setTransfiniteCurve(line, int(n) + 1)
         gmsh.model.mesh.setTransfiniteSurface(surface)
+        if quads:
+            gmsh.model.mesh.setRecombine(2, surface)
         for dim, tags, tag, name in ((2, [surface], 1, "shell"), (1, [mid], 2, "mid"), (1, [top], 3, "top"),
                                      (1, [side], 4, "side"), (0, [A], 5, "A"), (0, [B], 6, "B"), (0, [C], 7, "C")):
             gmsh.model.addPhysicalGroup(dim, tags, tag)

@@ -171,7 +171,7 @@ class Scene:
         return ref
 
     def add_shell(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float, material: Elastic,
-                  membrane: str | None = None, drilling: float = 1e-2) -> PartRef:
+                  membrane: str | None = None, drilling: float = 1e-2, kinematics: str = "kirchhoff") -> PartRef:
         """Flat co-rotational shells on group ``where`` of a triangle or quadrilateral mesh in space.
 
         Triangles: membrane with drilling rotations + DKT bending (Kirchhoff). membrane:
@@ -180,14 +180,18 @@ class Scene:
         constant-strain triangle with a drilling penalty α·G·t·A, α = ``drilling``.
 
         Quadrilaterals (possibly warped): the bilinear membrane with incompatible modes (QM6, no
-        locking in in-plane bending) and a drilling penalty ½·α·G·t∫(θz − ω)²dA, MITC4 bending and
-        transverse shear (Reissner–Mindlin, shear factor 5/6, free of shear locking); membrane
-        ``"qm6"`` or None. A quadrilateral mesh given shells carries its membranes with the same
-        element (add its shells first).
+        locking in in-plane bending) and a drilling penalty ½·α·G·t∫(θz − ω)²dA (membrane
+        ``"qm6"`` or None); bending by kinematics ``"kirchhoff"`` (the default), the discrete
+        Kirchhoff quadrilateral (DKQ), or ``"mindlin"``, MITC4 bending and transverse shear
+        (Reissner–Mindlin, shear factor 5/6, free of shear locking; for thick shells: bilinear
+        rotations make it stiffer than the DKQ where curvature changes fast on coarse meshes).
+        A quadrilateral mesh given shells carries its membranes with the same element (add its
+        shells first).
         """
         self._check_material("shell", where, material)
         model = self._model(tmesh, kind="shell")
-        ref = model.add_shell(where, material.E, material.nu, float(thickness), float(drilling), membrane)
+        ref = model.add_shell(where, material.E, material.nu, float(thickness), float(drilling), membrane,
+                              kinematics)
         model.set_mass(ref, material.density, float(thickness))
         return ref
 

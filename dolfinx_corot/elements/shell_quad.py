@@ -44,7 +44,8 @@ import numpy as np
 
 E_, NU, T, ALPHA = range(4)
 A0, B0, D0, S0 = 4, 13, 22, 31
-NPROPS = 35
+KIRCHHOFF = 35  # 1: discrete Kirchhoff bending (DKQ), 0: MITC4 (Reissner–Mindlin)
+NPROPS = 36
 KAPPA = 5.0 / 6.0  # shear correction factor of a homogeneous plate
 
 _G = 1.0 / np.sqrt(3.0)
@@ -52,8 +53,9 @@ _GAUSS = np.array([[-_G, -_G], [_G, -_G], [_G, _G], [-_G, _G]])
 _NODES = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
 
 
-def isotropic_props(E: float, nu: float, t: float, alpha: float) -> np.ndarray:
-    """props of a homogeneous isotropic shell (see the module's docstring)."""
+def isotropic_props(E: float, nu: float, t: float, alpha: float, kirchhoff: bool = True) -> np.ndarray:
+    """props of a homogeneous isotropic shell (see the module's docstring); bending by the DKQ
+    (``kirchhoff``) or MITC4."""
     c = E / (1.0 - nu * nu)
     C = np.array([[c, c * nu, 0.0], [c * nu, c, 0.0], [0.0, 0.0, 0.5 * c * (1.0 - nu)]])
     G = E / (2.0 * (1.0 + nu))
@@ -62,7 +64,75 @@ def isotropic_props(E: float, nu: float, t: float, alpha: float) -> np.ndarray:
     props[A0:A0 + 9] = (t * C).ravel()
     props[D0:D0 + 9] = (t ** 3 / 12.0 * C).ravel()
     props[S0:S0 + 4] = (KAPPA * G * t * np.eye(2)).ravel()
+    props[KIRCHHOFF] = 1.0 if kirchhoff else 0.0
     return props
+
+
+@numba.njit(cache=True)
+def _serendipity(xi, eta):
+    """d (2, 8): derivatives (∂/∂ξ, ∂/∂η) of the 8-node serendipity functions: corners 0–3
+    counter-clockwise, then the mid-sides of edges 01, 12, 23, 30."""
+    d = np.empty((2, 8))
+    for a in range(4):
+        xa, ya = _NODES[a, 0], _NODES[a, 1]
+        d[0, a] = 0.25 * xa * (1.0 + eta * ya) * (2.0 * xi * xa + eta * ya)
+        d[1, a] = 0.25 * ya * (1.0 + xi * xa) * (xi * xa + 2.0 * eta * ya)
+    for k in range(4):
+        xm = 0.5 * (_NODES[k, 0] + _NODES[(k + 1) % 4, 0])
+        ym = 0.5 * (_NODES[k, 1] + _NODES[(k + 1) % 4, 1])
+        if xm == 0.0:  # edge at η = ym: ½(1 − ξ²)(1 + η ym)
+            d[0, 4 + k] = -xi * (1.0 + eta * ym)
+            d[1, 4 + k] = 0.5 * (1.0 - xi * xi) * ym
+        else:          # edge at ξ = xm: ½(1 + ξ xm)(1 − η²)
+            d[0, 4 + k] = 0.5 * xm * (1.0 - eta * eta)
+            d[1, 4 + k] = -(1.0 + xi * xm) * eta
+    return d
+
+
+@numba.njit(cache=True)
+def dkq_B(xy, xi, eta):
+    """Bκ (3, 12): the curvatures κ = (βx,x, βy,y, βx,y + βy,x) of the discrete Kirchhoff
+    quadrilateral (Batoz & Ben Tahar 1982) at (ξ, η) on the plate dofs (w, θx, θy) per node.
+
+    The rotations of the normal β (u = zβ: βx = θy, βy = −θx at the corners) vary as the 8-node
+    serendipity field; at the mid-sides the Kirchhoff constraints fix them: the tangential
+    component follows the cubic deflection of the edge, β_s = −(3/2l)(w_j − w_i) − ¼(β_si + β_sj),
+    the normal one is linear, β_n = ½(β_ni + β_nj)."""
+    S = np.zeros((16, 12))  # (βx, βy) at the 8 nodes from the 12 corner dofs
+    for a in range(4):
+        S[2 * a, 3 * a + 2] = 1.0
+        S[2 * a + 1, 3 * a + 1] = -1.0
+    for k in range(4):
+        i, j = k, (k + 1) % 4
+        dx = xy[j, 0] - xy[i, 0]
+        dy = xy[j, 1] - xy[i, 1]
+        l = np.sqrt(dx * dx + dy * dy)
+        c, s = dx / l, dy / l  # tangent (c, s), normal (s, −c)
+        rs = np.zeros(12)
+        rn = np.zeros(12)
+        rs[3 * j] -= 1.5 / l
+        rs[3 * i] += 1.5 / l
+        for a in (i, j):  # β_s,a = c βx + s βy = c θy − s θx; β_n,a = s βx − c βy = s θy + c θx
+            rs[3 * a + 2] -= 0.25 * c
+            rs[3 * a + 1] += 0.25 * s
+            rn[3 * a + 2] += 0.5 * s
+            rn[3 * a + 1] += 0.5 * c
+        for col in range(12):
+            S[8 + 2 * k, col] = c * rs[col] + s * rn[col]
+            S[8 + 2 * k + 1, col] = s * rs[col] - c * rn[col]
+    d = _serendipity(xi, eta)
+    _, _, J, det = shape(xy, xi, eta)
+    B = np.zeros((3, 12))
+    for n in range(8):
+        nx = (J[1, 1] * d[0, n] - J[0, 1] * d[1, n]) / det
+        ny = (-J[1, 0] * d[0, n] + J[0, 0] * d[1, n]) / det
+        for col in range(12):
+            bx = S[2 * n, col]
+            by = S[2 * n + 1, col]
+            B[0, col] += nx * bx
+            B[1, col] += ny * by
+            B[2, col] += ny * bx + nx * by
+    return B
 
 
 @numba.njit(cache=True)
@@ -125,9 +195,10 @@ def _shear_tied(xy, xi, eta):
 
 # local dof numbers: membrane (u, v) of node a at 6a, 6a + 1; w, θx, θy at 6a + 2..4; θz at 6a + 5
 @numba.njit(cache=True)
-def _strains(xy, xi, eta, J0, det0):
+def _strains(xy, xi, eta, J0, det0, kirchhoff):
     """(Bε (3, 28), Bκ (3, 28), Bω (28,), N, det J) at (ξ, η) on the 24 dofs and the 4
-    incompatible modes (u: α1, α2; v: α3, α4) at 24..27."""
+    incompatible modes (u: α1, α2; v: α3, α4) at 24..27; κ of the DKQ (``kirchhoff``) or of the
+    bilinear rotations (MITC4)."""
     N, dx, J, det = shape(xy, xi, eta)
     Be = np.zeros((3, 28))
     Bk = np.zeros((3, 28))
@@ -140,11 +211,17 @@ def _strains(xy, xi, eta, J0, det0):
         Be[2, 6 * a + 1] = nx
         Bw[6 * a] = -0.5 * ny
         Bw[6 * a + 1] = 0.5 * nx
-        # κ = (βx,x, βy,y, βx,y + βy,x), βx = θy, βy = −θx
-        Bk[0, 6 * a + 4] = nx
-        Bk[1, 6 * a + 3] = -ny
-        Bk[2, 6 * a + 4] = ny
-        Bk[2, 6 * a + 3] = -nx
+        if not kirchhoff:  # κ = (βx,x, βy,y, βx,y + βy,x), βx = θy, βy = −θx
+            Bk[0, 6 * a + 4] = nx
+            Bk[1, 6 * a + 3] = -ny
+            Bk[2, 6 * a + 4] = ny
+            Bk[2, 6 * a + 3] = -nx
+    if kirchhoff:
+        Bp = dkq_B(xy, xi, eta)
+        for a in range(4):
+            for m in range(3):
+                for r in range(3):
+                    Bk[r, 6 * a + 2 + m] = Bp[r, 3 * a + m]
     # incompatible modes P1 = 1 − ξ², P2 = 1 − η² with J₀ and det J₀/det J
     s = det0 / det
     dP = np.array([[-2.0 * xi, 0.0], [0.0, -2.0 * eta]])  # dP[m] = (∂P_m/∂ξ, ∂P_m/∂η)
@@ -168,11 +245,12 @@ def flat_stiffness(xy, props, K):
     D = props[D0:D0 + 9].copy().reshape(3, 3)
     S = props[S0:S0 + 4].copy().reshape(2, 2)
     kd = props[ALPHA] * A[2, 2]
+    kirchhoff = props[KIRCHHOFF] != 0.0
     _, _, J0, det0 = shape(xy, 0.0, 0.0)
     Kf = np.zeros((28, 28))
     plate = np.array([2, 3, 4, 8, 9, 10, 14, 15, 16, 20, 21, 22])
     for q in range(4):
-        Be, Bk, Bw, N, det = _strains(xy, _GAUSS[q, 0], _GAUSS[q, 1], J0, det0)
+        Be, Bk, Bw, N, det = _strains(xy, _GAUSS[q, 0], _GAUSS[q, 1], J0, det0, kirchhoff)
         g = -Bw
         for a in range(4):
             g[6 * a + 5] += N[a]
@@ -187,6 +265,8 @@ def flat_stiffness(xy, props, K):
                 for r in range(3):
                     acc += Be[r, i] * Ne[r, j] + Bk[r, i] * Mk[r, j]
                 Kf[i, j] += det * (acc + kd * g[i] * g[j])
+        if kirchhoff:
+            continue
         for i in range(12):
             for j in range(12):
                 Kf[plate[i], plate[j]] += det * (Bs[0, i] * Qs[0, j] + Bs[1, i] * Qs[1, j])
@@ -219,26 +299,48 @@ def local_stiffness(xbar0, props, K):
 
 
 @numba.njit(cache=True)
+def _moments(xy, props, d, xi, eta, J0, det0, kirchhoff):
+    """(N (3,), M (3,)) at (ξ, η) from the flat element's dofs d (24,)."""
+    A = props[A0:A0 + 9].copy().reshape(3, 3)
+    Bc = props[B0:B0 + 9].copy().reshape(3, 3)
+    D = props[D0:D0 + 9].copy().reshape(3, 3)
+    Be, Bk, _, _, _ = _strains(xy, xi, eta, J0, det0, kirchhoff)
+    eps = np.ascontiguousarray(Be[:, :24]) @ d
+    kap = np.ascontiguousarray(Bk[:, :24]) @ d
+    return A @ eps + Bc @ kap, Bc @ eps + D @ kap
+
+
+@numba.njit(cache=True)
 def centre_resultants(xbar0, props, dbar, out):
     """out[:8] = (Nxx, Nyy, Nxy, Mxx, Myy, Mxy, Qx, Qy) at the centre from the local deformational
-    dofs dbar (24,) (the incompatible modes recovered from the condensation; they vanish in ε at
-    the centre). M = ∫σ z dz, Q = S γ (MITC4)."""
+    dofs dbar (24,) (the incompatible modes vanish in ε at the centre; the membrane forces are
+    those of the bilinear field). M = ∫σ z dz; Q = S γ of the MITC4 shear, or for the DKQ from
+    the moments' equilibrium, Qx = Mxx,x + Mxy,y, Qy = Mxy,x + Myy,y (central differences in
+    ξ, η over half the cell)."""
     xy = np.ascontiguousarray(xbar0[:, :2])
     d = dbar.copy()
     for a in range(4):
         z = xbar0[a, 2]
         d[6 * a] -= z * dbar[6 * a + 4]
         d[6 * a + 1] += z * dbar[6 * a + 3]
-    A = props[A0:A0 + 9].copy().reshape(3, 3)
-    Bc = props[B0:B0 + 9].copy().reshape(3, 3)
-    D = props[D0:D0 + 9].copy().reshape(3, 3)
-    S = props[S0:S0 + 4].copy().reshape(2, 2)
+    kirchhoff = props[KIRCHHOFF] != 0.0
     _, _, J0, det0 = shape(xy, 0.0, 0.0)
-    Be, Bk, _, _, _ = _strains(xy, 0.0, 0.0, J0, det0)
-    eps = np.ascontiguousarray(Be[:, :24]) @ d
-    kap = np.ascontiguousarray(Bk[:, :24]) @ d
-    out[0:3] = A @ eps + Bc @ kap
-    out[3:6] = Bc @ eps + D @ kap
+    N, M = _moments(xy, props, d, 0.0, 0.0, J0, det0, kirchhoff)
+    out[0:3] = N
+    out[3:6] = M
+    if kirchhoff:
+        h = 0.5
+        dxi = (_moments(xy, props, d, h, 0.0, J0, det0, kirchhoff)[1]
+               - _moments(xy, props, d, -h, 0.0, J0, det0, kirchhoff)[1]) / (2.0 * h)
+        deta = (_moments(xy, props, d, 0.0, h, J0, det0, kirchhoff)[1]
+                - _moments(xy, props, d, 0.0, -h, J0, det0, kirchhoff)[1]) / (2.0 * h)
+        # (∂/∂x, ∂/∂y) = J⁻¹ (∂/∂ξ, ∂/∂η)
+        dx = (J0[1, 1] * dxi - J0[0, 1] * deta) / det0
+        dy = (-J0[1, 0] * dxi + J0[0, 0] * deta) / det0
+        out[6] = dx[0] + dy[2]
+        out[7] = dx[2] + dy[1]
+        return
+    S = props[S0:S0 + 4].copy().reshape(2, 2)
     Bs = _shear_tied(xy, 0.0, 0.0)
     pd = np.empty(12)
     for a in range(4):

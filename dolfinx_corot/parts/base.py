@@ -706,8 +706,9 @@ class Part:
     def add_truss(self, where, area, material, prestress_force) -> PartRef:
         self._refuse_kind("truss", where, "bars need a mesh of lines")
 
-    def add_shell(self, where, E, nu, thickness, drilling, membrane) -> PartRef:
-        self._refuse_kind("shell", where, "shells need a triangle mesh in 3D (from_gmsh(model, gdim=3))")
+    def add_shell(self, where, E, nu, thickness, drilling, membrane, kinematics="kirchhoff") -> PartRef:
+        self._refuse_kind("shell", where, "shells need a triangle or quadrilateral mesh in 3D "
+                          "(from_gmsh(model, gdim=3))")
 
     def add_membrane(self, where, E, nu, thickness) -> PartRef:
         self._refuse_kind("membrane", where, "membranes need a triangle or quadrilateral mesh in 3D "

@@ -144,8 +144,12 @@ class Shell3D(Surface3D):
                                       "cells (set Mesh.RecombineAll = 0 in gmsh)")
         super().__init__(tmesh, large_rotations)
 
-    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str | None = None):
+    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str | None = None,
+                  kinematics: str = "kirchhoff"):
         label = f"shell '{where}'"
+        if kinematics != "kirchhoff":
+            raise ValueError(f"{label}: kinematics '{kinematics}': shell triangles bend as discrete Kirchhoff "
+                             "triangles; Reissner–Mindlin shells ('mindlin', MITC4) need a quadrilateral mesh")
         if not (thickness > 0.0 and np.isfinite(thickness)):
             raise ValueError(f"{label}: thickness = {thickness} must be positive")
         if not drilling > 0.0:
@@ -180,15 +184,18 @@ class ShellQuad(Surface3D):
     nprops = quad_shell_law.NPROPS
     kernels = OnFirstUse("shell_quad")
 
-    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str | None = None):
+    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str | None = None,
+                  kinematics: str = "kirchhoff"):
         label = f"shell '{where}'"
         quad_law.check_props(E, nu, thickness, label)
+        if kinematics not in ("kirchhoff", "mindlin"):
+            raise ValueError(f"{label}: kinematics '{kinematics}' is not 'kirchhoff' (DKQ) or 'mindlin' (MITC4)")
         if not (drilling > 0.0 and np.isfinite(drilling)):
             raise ValueError(f"{label}: the drilling factor {drilling} must be positive")
         if membrane not in (None, "qm6"):
             raise ValueError(f"{label}: membrane '{membrane}' is for triangles; a quadrilateral shell's membrane is "
                              "'qm6' (bilinear with incompatible modes)")
-        props = quad_shell_law.isotropic_props(E, nu, thickness, drilling)
+        props = quad_shell_law.isotropic_props(E, nu, thickness, drilling, kinematics == "kirchhoff")
         return self.add_elements(where, props, True, "shell")
 
     def add_membrane(self, where, E: float, nu: float, thickness: float):
@@ -216,7 +223,7 @@ class MembraneQuad(Surface3D):
     nprops = quad_law.NPROPS
     kernels = OnFirstUse("membrane_quad")
 
-    def add_shell(self, where, E, nu, thickness, drilling, membrane) -> PartRef:
+    def add_shell(self, where, E, nu, thickness, drilling, membrane, kinematics="kirchhoff") -> PartRef:
         raise ValueError(f"shell '{where}': this quadrilateral mesh was given membranes first, which made it a "
                          "part of membranes alone (bilinear Q4); add its shells before its membranes, so that "
                          "the mesh carries four-node shells and its membranes are the shell's membrane")

@@ -170,9 +170,17 @@ class Scene:
         model.set_mass(ref, material.density, section.A)
         return ref
 
-    def add_shell(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float, material: Elastic,
-                  membrane: str | None = None, drilling: float = 1e-2, kinematics: str = "kirchhoff") -> PartRef:
+    def add_shell(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float | None = None,
+                  material=None, section=None, axis=None, membrane: str | None = None, drilling: float = 1e-2,
+                  kinematics: str = "kirchhoff") -> PartRef:
         """Flat co-rotational shells on group ``where`` of a triangle or quadrilateral mesh in space.
+
+        The section: ``thickness`` and ``material`` (``dc.Elastic``, or ``dc.Orthotropic``, a single
+        layer), or ``section=dc.Laminate([...])`` (plies from the bottom face to the top one, the
+        top on the side of the element normal e₃, which follows the right-hand rule over a cell's
+        nodes: orient the mesh consistently). ``axis``: the material axis 1 of orthotropic plies,
+        (x, y, z) or a function of the points (n, 3) → (n, 3), projected onto each cell; a ply's
+        angle is counted from it about e₃.
 
         Triangles: membrane with drilling rotations + DKT bending (Kirchhoff). membrane:
         ``"opt"`` (the default), Felippa's optimal ANDES triangle, whose drilling rotations carry
@@ -183,29 +191,52 @@ class Scene:
         locking in in-plane bending) and a drilling penalty ½·α·G·t∫(θz − ω)²dA (membrane
         ``"qm6"`` or None); bending by kinematics ``"kirchhoff"`` (the default), the discrete
         Kirchhoff quadrilateral (DKQ), or ``"mindlin"``, MITC4 bending and transverse shear
-        (Reissner–Mindlin, shear factor 5/6, free of shear locking; for thick shells: bilinear
-        rotations make it stiffer than the DKQ where curvature changes fast on coarse meshes).
-        A quadrilateral mesh given shells carries its membranes with the same element (add its
-        shells first).
+        (Reissner–Mindlin, shear factor 5/6, free of shear locking; for thick shells and the
+        transverse shear of laminates: bilinear rotations make it stiffer than the DKQ where
+        curvature changes fast on coarse meshes). A quadrilateral mesh given shells carries its
+        membranes with the same element (add its shells first).
         """
-        self._check_material("shell", where, material)
+        section, density = self._shell_section("shell", where, thickness, material, section)
         model = self._model(tmesh, kind="shell")
-        ref = model.add_shell(where, material.E, material.nu, float(thickness), float(drilling), membrane,
-                              kinematics)
-        model.set_mass(ref, material.density, float(thickness))
+        ref = model.add_shell(where, section, float(drilling), membrane, kinematics, axis)
+        model.set_mass(ref, density, section.thickness)
         return ref
 
-    def add_membrane(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float,
-                     material: Elastic) -> PartRef:
+    def add_membrane(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float | None = None,
+                     material=None, section=None, axis=None) -> PartRef:
         """Co-rotational membranes (in-plane stiffness only) on group ``where`` of a triangle
         (constant-strain triangles) or quadrilateral mesh in space (bilinear Q4; on a mesh that also
         carries shells, the shell's membrane with incompatible modes); nodes carried by membranes
-        alone have their rotations fixed."""
-        self._check_material("membrane", where, material)
+        alone have their rotations fixed. The section as for :meth:`add_shell` (its membrane
+        stiffness A alone): an orthotropic fabric is ``material=dc.Orthotropic(...)`` with its
+        warp direction as ``axis``."""
+        section, density = self._shell_section("membrane", where, thickness, material, section)
         model = self._model(tmesh)
-        ref = model.add_membrane(where, material.E, material.nu, float(thickness))
-        model.set_mass(ref, material.density, float(thickness))
+        ref = model.add_membrane(where, section, axis)
+        model.set_mass(ref, density, section.thickness)
         return ref
+
+    @staticmethod
+    def _shell_section(kind: str, where, thickness, material, section):
+        """(Laminate, density) of a shell or membrane from (thickness, material) or section."""
+        from .materials import Orthotropic
+        from .sections import Laminate
+
+        label = f"{kind} '{where}'"
+        if section is not None:
+            if thickness is not None or material is not None:
+                raise ValueError(f"{label}: give either section=dc.Laminate(...) or thickness and material, "
+                                 "not both")
+            if not isinstance(section, Laminate):
+                raise TypeError(f"{label}: section must be dc.Laminate, got {type(section).__name__}")
+            return section, section.density
+        if thickness is None or material is None:
+            raise ValueError(f"{label}: give thickness and material (or section=dc.Laminate(...))")
+        if not isinstance(material, (Elastic, Orthotropic)):
+            raise TypeError(f"{label}: material must be dc.Elastic or dc.Orthotropic, got {type(material).__name__}")
+        if not (np.isfinite(thickness) and thickness > 0.0):
+            raise ValueError(f"{label}: thickness = {thickness} must be positive")
+        return Laminate.single(float(thickness), material), material.density
 
     def add_truss(self, tmesh: TaggedMesh, where: str | None = None, *, area: float, material: Elastic,
                   prestress_force: float = 0.0) -> PartRef:

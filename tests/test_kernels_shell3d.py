@@ -6,9 +6,9 @@ from dolfinx_corot import rotations as rot
 from dolfinx_corot.elements import shell_triangle as law
 from dolfinx_corot.kernels import shell3d as k
 
-PROPS = np.array([2.1e4, 0.3, 0.05, 1e-2, 1.0, 1.0])
-KINDS = {"shell": PROPS, "shell_cst": np.array([2.1e4, 0.3, 0.05, 1e-2, 1.0, 0.0]),
-         "membrane": np.array([2.1e4, 0.3, 0.05, 0.0, 0.0, 0.0])}
+PROPS = law.isotropic_props(2.1e4, 0.3, 0.05, 1e-2, True, True)
+KINDS = {"shell": PROPS, "shell_cst": law.isotropic_props(2.1e4, 0.3, 0.05, 1e-2, True, False),
+         "membrane": law.isotropic_props(2.1e4, 0.3, 0.05, 0.0, False, False)}
 
 
 def _eval(X, S, large=True, props=PROPS):

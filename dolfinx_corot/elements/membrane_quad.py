@@ -6,15 +6,18 @@ Gauss points; dofs (ū, v̄) per node. It passes the patch test on any convex
 quadrilateral; like every Q4 it is stiff in in-plane bending, which
 membranes (fabrics, sheets, cable-net infills) rarely carry.
 
-``props = (E, nu, t)``.
+``props = (E, nu, t)``, or ``(E, nu, t, A (3 × 3) row-major)`` with the section's membrane
+stiffness A = Σ Q̄_k t_k (an orthotropic or laminated membrane, in the element's axes; E and ν a
+reference).
 """
 from __future__ import annotations
 
 import numba
 import numpy as np
 
-NPROPS = 3
-E_, NU, T = range(NPROPS)
+NPROPS = 12
+E_, NU, T = range(3)
+A0 = 3
 
 _G = 1.0 / np.sqrt(3.0)
 _GAUSS = np.array([[-_G, -_G], [_G, -_G], [_G, _G], [-_G, _G]])
@@ -56,11 +59,21 @@ def strain_B(xy, xi, eta, B):
 
 
 @numba.njit(cache=True)
+def plane_stress(props):
+    """The plane-stress stiffness D (3, 3) of the membrane's material (A/t when A is given)."""
+    t = props[T]
+    if props.shape[0] > A0:
+        return props[A0:A0 + 9].copy().reshape(3, 3) / t
+    E, nu = props[E_], props[NU]
+    c = E / (1.0 - nu * nu)
+    return np.array([[c, c * nu, 0.0], [c * nu, c, 0.0], [0.0, 0.0, c * (1.0 - nu) / 2.0]])
+
+
+@numba.njit(cache=True)
 def local_stiffness(xy, props, K):
     """K (8, 8) for the local node coordinates xy (4, 2), counter-clockwise."""
-    E, nu, t = props[E_], props[NU], props[T]
-    c = E / (1.0 - nu * nu)
-    D = np.array([[c, c * nu, 0.0], [c * nu, c, 0.0], [0.0, 0.0, c * (1.0 - nu) / 2.0]])
+    t = props[T]
+    D = plane_stress(props)
     K[:, :] = 0.0
     B = np.zeros((3, 8))
     for q in range(4):

@@ -29,17 +29,37 @@ the local x–y plane. Material: isotropic, plane stress, thickness t.
   :math:`\boldsymbol\kappa = (\beta_{x,x}, \beta_{y,y}, \beta_{x,y} + \beta_{y,x})`,
   :math:`\mathbf K_b = \int\mathbf B_b^T\mathbf D_b\mathbf B_b\,dA` by a 3-point rule (exact).
 
-``props = (E, nu, t, alpha, bending, opt)``; ``bending = 0`` gives a membrane:
-the constant-strain triangle alone, no drilling and no bending stiffness;
-``opt = 1`` selects the OPT membrane, 0 the CST with drilling penalty α.
+``props = (E, nu, t, alpha, bending, opt, A (3 × 3), B (3 × 3), D (3 × 3))``, the matrices
+row-major: the section N = Aε + Bκ, M = Bε + Dκ (κ of the rotations of the normal, u(z) = zβ;
+isotropic: A = tC, B = 0, D = t³C/12, see :func:`isotropic_props`; laminates:
+:class:`dolfinx_corot.sections.Laminate`). The membranes take A (OPT: D = A/t in its formulas,
+β₀ from ν = A12/A22), the DKT takes D; B couples the constant membrane strain of the CST with
+the DKT's curvatures (for the OPT membrane, its constant-strain part: exact for symmetric
+laminates, where B = 0). E and ν are a reference (contact stiffness scale, OPT's β₀).
+``bending = 0`` gives a membrane: the constant-strain triangle alone, no drilling and no
+bending stiffness; ``opt = 1`` selects the OPT membrane, 0 the CST with drilling penalty
+α·A66·A (A66 = Gt).
 """
 from __future__ import annotations
 
 import numba
 import numpy as np
 
-NPROPS = 6
-E_, NU, T, ALPHA, BENDING, OPT = range(NPROPS)
+E_, NU, T, ALPHA, BENDING, OPT = range(6)
+A0, B0, D0 = 6, 15, 24
+NPROPS = 33
+
+
+def isotropic_props(E: float, nu: float, t: float, alpha: float, bending: bool, opt: bool) -> np.ndarray:
+    """props of a homogeneous isotropic shell or membrane (see the module's docstring)."""
+    c = E / (1.0 - nu * nu)
+    C = np.array([[c, c * nu, 0.0], [c * nu, c, 0.0], [0.0, 0.0, 0.5 * c * (1.0 - nu)]])
+    props = np.zeros(NPROPS)
+    props[:6] = E, nu, t, alpha, float(bending), float(opt)
+    props[A0:A0 + 9] = (t * C).ravel()
+    if bending:
+        props[D0:D0 + 9] = (t ** 3 / 12.0 * C).ravel()
+    return props
 
 # OPT signature (Felippa 2003): α_b and β1..β9 (index 0 unused)
 ALPHA_B = 1.5
@@ -79,14 +99,14 @@ def membrane_B(xy):
 
 
 @numba.njit(cache=True)
-def opt_membrane(xy, E, nu, t):
-    """OPT membrane stiffness (9, 9) on (u, v, θz) of nodes 1–3 (counter-clockwise, local x–y)."""
+def opt_membrane(xy, D, nu, t):
+    """OPT membrane stiffness (9, 9) on (u, v, θz) of nodes 1–3 (counter-clockwise, local x–y),
+    plane-stress stiffness D (3, 3) (the section's A/t), ν for β₀, thickness t."""
     x1, y1, x2, y2, x3, y3 = xy[0, 0], xy[0, 1], xy[1, 0], xy[1, 1], xy[2, 0], xy[2, 1]
     x12, x21, x13, x31, x23, x32 = x1 - x2, x2 - x1, x1 - x3, x3 - x1, x2 - x3, x3 - x2
     y12, y21, y13, y31, y23, y32 = y1 - y2, y2 - y1, y1 - y3, y3 - y1, y2 - y3, y3 - y2
     A = 0.5 * (x21 * y31 - x31 * y21)
     V = A * t
-    D = plane_stress(E, nu)
     a6, a3 = ALPHA_B / 6.0, ALPHA_B / 3.0
     L = np.zeros((9, 3))
     L[0, 0], L[0, 2] = y23, x32
@@ -255,25 +275,27 @@ def _add_btdb(B, D, w, dofs, K):
 @numba.njit(cache=True)
 def local_stiffness(xy, props, K):
     """Fill K (18, 18), the linear stiffness of the flat triangle with local node coordinates xy (3, 2)."""
-    E, nu, t, alpha = props[E_], props[NU], props[T], props[ALPHA]
+    t, alpha = props[T], props[ALPHA]
+    Am = props[A0:A0 + 9].copy().reshape(3, 3)
+    Bc = props[B0:B0 + 9].copy().reshape(3, 3)
+    Db = props[D0:D0 + 9].copy().reshape(3, 3)
     K[:, :] = 0.0
     Bm, A2 = membrane_B(xy)
     A = 0.5 * A2
+    mem = np.array([0, 1, 6, 7, 12, 13])
     if props[BENDING] != 0.0 and props[OPT] != 0.0:
-        Km = opt_membrane(xy, E, nu, t)
+        Km = opt_membrane(xy, Am / t, Am[0, 1] / Am[1, 1], t)
         mdofs = np.array([0, 1, 5, 6, 7, 11, 12, 13, 17])
         for a in range(9):
             for b in range(9):
                 K[mdofs[a], mdofs[b]] += Km[a, b]
     else:
-        Dm = plane_stress(E, nu) * t
-        _add_btdb(Bm, Dm, A, np.array([0, 1, 6, 7, 12, 13]), K)
+        _add_btdb(Bm, Am, A, mem, K)
     if props[BENDING] == 0.0:
         return
     if props[OPT] == 0.0:
         # drilling: (θz_i − ω), ω = ½(v,x − u,y) from the CST
-        G = E / (2.0 * (1.0 + nu))
-        kd = alpha * G * t * A
+        kd = alpha * Am[2, 2] * A
         om = np.zeros(18)
         for a in range(3):
             om[6 * a] = -0.5 * Bm[1, 2 * a + 1]   # −½ ∂N/∂y on u
@@ -284,8 +306,16 @@ def local_stiffness(xy, props, K):
             for a in range(18):
                 for b in range(18):
                     K[a, b] += kd * g[a] * g[b]
-    # bending
-    Db = plane_stress(E, nu) * (t * t * t / 12.0)
+    # bending (the DKT's curvature of the slopes is −κ)
     bend = np.array([2, 3, 4, 8, 9, 10, 14, 15, 16])
+    coupled = np.abs(Bc).max() > 0.0
     for q in range(3):
-        _add_btdb(bending_B(xy, _GP[q, 0], _GP[q, 1]), Db, A / 3.0, bend, K)
+        Bb = bending_B(xy, _GP[q, 0], _GP[q, 1])
+        _add_btdb(Bb, Db, A / 3.0, bend, K)
+        if coupled:  # εᵀ B κ + κᵀ B ε with κ = −Bb w
+            BB = Bc @ Bb
+            for a in range(6):
+                for b in range(9):
+                    v = -(A / 3.0) * (Bm[0, a] * BB[0, b] + Bm[1, a] * BB[1, b] + Bm[2, a] * BB[2, b])
+                    K[mem[a], bend[b]] += v
+                    K[bend[b], mem[a]] += v

@@ -160,10 +160,9 @@ def resultants(X, S, props, large_rotations, out, axes):
         frame.basic(Xc, np.zeros((4, 3)), xbar0, np.empty(8), B)
         dbar[:] = B @ u.ravel()
         R = R0
-    E, nu, t = props[law.E_], props[law.NU], props[law.T]
-    c = E / (1.0 - nu * nu)
+    t = props[law.T]
     eps = law.centre_B(np.ascontiguousarray(xbar0[:, :2])) @ dbar
-    N = np.array([c * (eps[0] + nu * eps[1]), c * (nu * eps[0] + eps[1]), c * (1.0 - nu) / 2.0 * eps[2]]) * t
+    N = (law.plane_stress(props) * t) @ eps
     out[:] = 0.0
     out[0:3] = N
     s = N / t

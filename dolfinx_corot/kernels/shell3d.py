@@ -194,18 +194,21 @@ def resultants(X, S, props, edata, large_rotations, out, axes):
         dbar[:] = B @ d
         axes[:, :] = R0.T
     xy = np.ascontiguousarray(xbar0[:, :2])
-    E, nu, t = props[law.E_], props[law.NU], props[law.T]
-    D = law.plane_stress(E, nu)
+    t = props[law.T]
+    Am = props[law.A0:law.A0 + 9].copy().reshape(3, 3)
+    Bc = props[law.B0:law.B0 + 9].copy().reshape(3, 3)
+    Db = props[law.D0:law.D0 + 9].copy().reshape(3, 3)
     Bm, _ = law.membrane_B(xy)
     uv = np.array([dbar[0], dbar[1], dbar[6], dbar[7], dbar[12], dbar[13]])
-    N = t * (D @ (Bm @ uv))
+    eps = Bm @ uv
+    N = Am @ eps
     out[:] = 0.0
-    out[0:3] = N
     M = np.zeros(3)
-    if bending:
+    if bending:  # κ = −(the DKT's curvature of the slopes)
         wt = np.array([dbar[2], dbar[3], dbar[4], dbar[8], dbar[9], dbar[10], dbar[14], dbar[15], dbar[16]])
-        Db = D * (t * t * t / 12.0)
-        M = -(Db @ (law.bending_B(xy, 1.0 / 3.0, 1.0 / 3.0) @ wt))
+        kap = -(law.bending_B(xy, 1.0 / 3.0, 1.0 / 3.0) @ wt)
+        N = N + Bc @ kap
+        M = Bc @ eps + Db @ kap
         M0 = -(Db @ (law.bending_B(xy, 0.0, 0.0) @ wt))
         dxi = -(Db @ (law.bending_B(xy, 1.0, 0.0) @ wt)) - M0
         deta = -(Db @ (law.bending_B(xy, 0.0, 1.0) @ wt)) - M0
@@ -218,6 +221,7 @@ def resultants(X, S, props, edata, large_rotations, out, axes):
         out[3:6] = M
         out[6] = dx[0] + dy[2]
         out[7] = dx[2] + dy[1]
+    out[0:3] = N
     for side in range(2):
         z = 1.0 if side == 0 else -1.0
         sig = N / t + z * 6.0 * M / (t * t)

@@ -706,11 +706,11 @@ class Part:
     def add_truss(self, where, area, material, prestress_force) -> PartRef:
         self._refuse_kind("truss", where, "bars need a mesh of lines")
 
-    def add_shell(self, where, E, nu, thickness, drilling, membrane, kinematics="kirchhoff") -> PartRef:
+    def add_shell(self, where, section, drilling, membrane=None, kinematics="kirchhoff", axis=None) -> PartRef:
         self._refuse_kind("shell", where, "shells need a triangle or quadrilateral mesh in 3D "
                           "(from_gmsh(model, gdim=3))")
 
-    def add_membrane(self, where, E, nu, thickness) -> PartRef:
+    def add_membrane(self, where, section, axis=None) -> PartRef:
         self._refuse_kind("membrane", where, "membranes need a triangle or quadrilateral mesh in 3D "
                           "(from_gmsh(model, gdim=3))")
 

@@ -73,22 +73,31 @@ class LineFrame(Part):
         self._init_conditions()
 
     # -- building -----------------------------------------------------------
-    def add_elements(self, where: str | None, props: np.ndarray, bending: bool, kind: str) -> PartRef:
+    def add_elements(self, where: str | None, props, bending: bool, kind: str,
+                     fingerprint: list[float] | None = None) -> PartRef:
+        """Elements of ``kind`` on the cells of group ``where``: ``props`` one row of properties
+        for all of them, or a function of the local cells giving one row per cell (then
+        ``fingerprint``: the numbers that describe them, the same on every rank)."""
         label = f"{kind} '{where or 'all cells'}'"
         cells = self.tmesh.cells(where)
         taken = self._owner_of_cell[cells]
         clash = taken[taken != ""]
         if len(clash):
             raise ValueError(f"{label}: its cells already belong to {clash[0]}")
-        self._check_geometry(cells, label, props)
+        if callable(props):  # rows from the cells' geometry, once it is checked
+            self._check_geometry(cells, label, None)
+            rows = props(cells, label)
+        else:
+            rows = props
+            self._check_geometry(cells, label, rows)
         self._owner_of_cell[cells] = label
         self._bending[cells] = bending
         values = self.props.x.array.reshape(-1, self.nprops)
-        values[self._prop_blocks[cells]] = props
+        values[self._prop_blocks[cells]] = rows
         self.props.x.scatter_forward()
         ref = PartRef(self, where or "", kind)
         self.parts.append(ref)
-        self._element_props.append((label, [float(v) for v in props]))
+        self._element_props.append((label, [float(v) for v in (props if fingerprint is None else fingerprint)]))
         self._forms = None
         return ref
 

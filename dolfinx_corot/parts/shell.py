@@ -129,6 +129,78 @@ class Surface3D(Rotations3D, LineFrame):
         """The thickness."""
         return self.cell_properties(cells)[:, 2]
 
+    # -- sections: laminates and material axes ----------------------------------------------
+    def _initial_axes(self, cells: np.ndarray):
+        """(e1, e2, e3, centroid), each (n, 3): the initial element frames of local cells
+        (triangles: e1 along side 1–2; quadrilaterals: e1 between the diagonals; e3 the normal by
+        the right-hand rule over the nodes)."""
+        mesh = self.tmesh.mesh
+        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, self.nodes_per_cell)[cells]]
+        if self.nodes_per_cell == 3:
+            e1 = X[:, 1] - X[:, 0]
+            n = np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
+        else:
+            X = X[:, CCW]
+            d1, d2 = X[:, 2] - X[:, 0], X[:, 3] - X[:, 1]
+            n = np.cross(d1, d2)
+            e1 = d1 / np.linalg.norm(d1, axis=1)[:, None] - d2 / np.linalg.norm(d2, axis=1)[:, None]
+        e1 = e1 / np.linalg.norm(e1, axis=1)[:, None]
+        e3 = n / np.linalg.norm(n, axis=1)[:, None]
+        return e1, np.cross(e3, e1), e3, X.mean(axis=1)
+
+    def _material_angles(self, cells: np.ndarray, axis, label: str) -> np.ndarray:
+        """The angle (n,) of the material axis 1 from each cell's e1 about e3: ``axis`` (3,) or a
+        function of the centroids (n, 3) → (n, 3), projected onto the cell's plane."""
+        e1, e2, e3, centre = self._initial_axes(cells)
+        if callable(axis):
+            a = np.asarray(axis(centre), dtype=float)
+        else:
+            a = np.broadcast_to(np.asarray(axis, dtype=float), (len(cells), 3))
+        if a.shape != (len(cells), 3) or not np.all(np.isfinite(a)):
+            raise ValueError(f"{label}: the material axis must be 3 finite numbers, or a function of the points "
+                             f"(n, 3) giving (n, 3) vectors; got shape {a.shape}")
+        a1, a2 = np.einsum("ni,ni->n", a, e1), np.einsum("ni,ni->n", a, e2)
+        bad = np.flatnonzero(np.hypot(a1, a2) <= 1e-6 * np.linalg.norm(a, axis=1))
+        refuse(self.tmesh.mesh, label, [("the material axis is normal to {n} cell(s), the first at {at}: "
+                                         "give an axis that lies in the shell", cells[bad])], ValueError)
+        return np.arctan2(a2, a1)
+
+    def _section_rows(self, head: np.ndarray, section, axis, slots: tuple, bending: bool):
+        """A function of (cells, label) giving the cells' property rows: ``head`` then the
+        section's A, B, D (and S when ``slots`` has four entries) at their slots, turned to each
+        cell's initial frame (membranes: A alone)."""
+        def rows(cells, label):
+            angles = np.zeros(len(cells))
+            if not section.isotropic:
+                if axis is None:
+                    raise ValueError(f"{label}: the section has orthotropic plies: give the material axis 1 "
+                                     "(axis=(x, y, z), projected onto each cell, or a function of the points)")
+                angles = self._material_angles(cells, axis, label)
+            out = np.tile(head, (len(cells), 1))
+            for slot, m in zip(slots, section.matrices(angles)):
+                if slot is not None and (bending or slot == slots[0]):
+                    out[:, slot:slot + m[0].size] = m.reshape(len(cells), -1)
+            return out
+        return rows
+
+    @staticmethod
+    def _reference_modulus(section) -> tuple[float, float]:
+        """(E, ν) of the section's membrane stiffness along the material axis 1, from
+        A = A(0): ν = A12/A22, E = (A11 A22 − A12²)/(A22 t) (an isotropic layer: its E and ν)."""
+        A = section.matrices(0.0)[0][0]
+        t = section.thickness
+        return float((A[0, 0] * A[1, 1] - A[0, 1] ** 2) / (A[1, 1] * t)), float(A[0, 1] / A[1, 1])
+
+    @staticmethod
+    def _fingerprint(head, section, axis) -> list[float]:
+        out = [float(v) for v in head]
+        for p in section.plies:
+            m = p.material
+            out += [p.thickness, p.angle] + [float(v) if v is not None else -1.0 for v in vars(m).values()]
+        if axis is not None and not callable(axis):
+            out += [float(v) for v in np.asarray(axis, dtype=float)]
+        return out
+
 
 class Shell3D(Surface3D):
     """Flat co-rotational shell triangles on a triangle mesh in space; dofs (ux, uy, uz, rx, ry, rz)
@@ -144,26 +216,29 @@ class Shell3D(Surface3D):
                                       "cells (set Mesh.RecombineAll = 0 in gmsh)")
         super().__init__(tmesh, large_rotations)
 
-    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str | None = None,
-                  kinematics: str = "kirchhoff"):
+    def add_shell(self, where, section, drilling: float, membrane: str | None = None, kinematics: str = "kirchhoff",
+                  axis=None):
         label = f"shell '{where}'"
         if kinematics != "kirchhoff":
             raise ValueError(f"{label}: kinematics '{kinematics}': shell triangles bend as discrete Kirchhoff "
                              "triangles; Reissner–Mindlin shells ('mindlin', MITC4) need a quadrilateral mesh")
-        if not (thickness > 0.0 and np.isfinite(thickness)):
-            raise ValueError(f"{label}: thickness = {thickness} must be positive")
-        if not drilling > 0.0:
+        if not (drilling > 0.0 and np.isfinite(drilling)):
             raise ValueError(f"{label}: the drilling factor {drilling} must be positive")
         membrane = "opt" if membrane is None else membrane
         if membrane not in ("opt", "cst"):
             raise ValueError(f"{label}: membrane '{membrane}' is not one of the triangles' ('opt', 'cst')")
-        opt = 1.0 if membrane == "opt" else 0.0
-        return self.add_elements(where, np.array([E, nu, thickness, drilling, 1.0, opt]), True, "shell")
+        E, nu = self._reference_modulus(section)
+        head = np.zeros(shell_law.NPROPS)
+        head[:6] = E, nu, section.thickness, drilling, 1.0, 1.0 if membrane == "opt" else 0.0
+        rows = self._section_rows(head, section, axis, (shell_law.A0, shell_law.B0, shell_law.D0), True)
+        return self.add_elements(where, rows, True, "shell", self._fingerprint(head, section, axis))
 
-    def add_membrane(self, where, E: float, nu: float, thickness: float):
-        if not (thickness > 0.0 and np.isfinite(thickness)):
-            raise ValueError(f"membrane '{where}': thickness = {thickness} must be positive")
-        return self.add_elements(where, np.array([E, nu, thickness, 0.0, 0.0, 0.0]), False, "membrane")
+    def add_membrane(self, where, section, axis=None):
+        E, nu = self._reference_modulus(section)
+        head = np.zeros(shell_law.NPROPS)
+        head[:3] = E, nu, section.thickness
+        rows = self._section_rows(head, section, axis, (shell_law.A0, None, None), False)
+        return self.add_elements(where, rows, False, "membrane", self._fingerprint(head, section, axis))
 
     def _check_geometry(self, cells, label, props):
         """Refuse triangles of zero size or area (MeshError naming the first)."""
@@ -184,10 +259,9 @@ class ShellQuad(Surface3D):
     nprops = quad_shell_law.NPROPS
     kernels = OnFirstUse("shell_quad")
 
-    def add_shell(self, where, E: float, nu: float, thickness: float, drilling: float, membrane: str | None = None,
-                  kinematics: str = "kirchhoff"):
+    def add_shell(self, where, section, drilling: float, membrane: str | None = None, kinematics: str = "kirchhoff",
+                  axis=None):
         label = f"shell '{where}'"
-        quad_law.check_props(E, nu, thickness, label)
         if kinematics not in ("kirchhoff", "mindlin"):
             raise ValueError(f"{label}: kinematics '{kinematics}' is not 'kirchhoff' (DKQ) or 'mindlin' (MITC4)")
         if not (drilling > 0.0 and np.isfinite(drilling)):
@@ -195,14 +269,20 @@ class ShellQuad(Surface3D):
         if membrane not in (None, "qm6"):
             raise ValueError(f"{label}: membrane '{membrane}' is for triangles; a quadrilateral shell's membrane is "
                              "'qm6' (bilinear with incompatible modes)")
-        props = quad_shell_law.isotropic_props(E, nu, thickness, drilling, kinematics == "kirchhoff")
-        return self.add_elements(where, props, True, "shell")
+        E, nu = self._reference_modulus(section)
+        head = np.zeros(quad_shell_law.NPROPS)
+        head[:4] = E, nu, section.thickness, drilling
+        head[quad_shell_law.KIRCHHOFF] = 1.0 if kinematics == "kirchhoff" else 0.0
+        slots = (quad_shell_law.A0, quad_shell_law.B0, quad_shell_law.D0, quad_shell_law.S0)
+        rows = self._section_rows(head, section, axis, slots, True)
+        return self.add_elements(where, rows, True, "shell", self._fingerprint(head, section, axis))
 
-    def add_membrane(self, where, E: float, nu: float, thickness: float):
-        quad_law.check_props(E, nu, thickness, f"membrane '{where}'")
-        props = quad_shell_law.isotropic_props(E, nu, thickness, 0.0)
-        props[quad_shell_law.D0:] = 0.0  # no bending, no transverse shear
-        return self.add_elements(where, props, False, "membrane")
+    def add_membrane(self, where, section, axis=None):
+        E, nu = self._reference_modulus(section)
+        head = np.zeros(quad_shell_law.NPROPS)
+        head[:3] = E, nu, section.thickness
+        rows = self._section_rows(head, section, axis, (quad_shell_law.A0, None, None, None), False)
+        return self.add_elements(where, rows, False, "membrane", self._fingerprint(head, section, axis))
 
     def _check_geometry(self, cells, label, props):
         """Refuse quadrilaterals of zero size or area, self-intersecting, not convex, with three
@@ -223,14 +303,17 @@ class MembraneQuad(Surface3D):
     nprops = quad_law.NPROPS
     kernels = OnFirstUse("membrane_quad")
 
-    def add_shell(self, where, E, nu, thickness, drilling, membrane, kinematics="kirchhoff") -> PartRef:
+    def add_shell(self, where, section, drilling, membrane=None, kinematics="kirchhoff", axis=None) -> PartRef:
         raise ValueError(f"shell '{where}': this quadrilateral mesh was given membranes first, which made it a "
                          "part of membranes alone (bilinear Q4); add its shells before its membranes, so that "
                          "the mesh carries four-node shells and its membranes are the shell's membrane")
 
-    def add_membrane(self, where, E: float, nu: float, thickness: float):
-        quad_law.check_props(E, nu, thickness, f"membrane '{where}'")
-        return self.add_elements(where, np.array([E, nu, thickness]), False, "membrane")
+    def add_membrane(self, where, section, axis=None):
+        E, nu = self._reference_modulus(section)
+        head = np.zeros(quad_law.NPROPS)
+        head[:3] = E, nu, section.thickness
+        rows = self._section_rows(head, section, axis, (quad_law.A0, None, None), False)
+        return self.add_elements(where, rows, False, "membrane", self._fingerprint(head, section, axis))
 
     def _check_geometry(self, cells, label, props):
         """Refuse quadrilaterals of zero size or area, self-intersecting, not convex, with three

@@ -223,7 +223,7 @@ def _locate_vertices(mesh: dolfinx.mesh.Mesh, pts: np.ndarray) -> np.ndarray:
 
 
 def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
-              dim: int | None = None) -> TaggedMesh:
+              dim: int | None = None, cells: str | None = None) -> TaggedMesh:
     """Distribute the meshed gmsh ``model`` (alive on ``rank``) as a :class:`TaggedMesh`.
 
     dim: dimension of the cells (default: the highest dimension of the
@@ -233,6 +233,12 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
     share the nodes they have in common. Every cell of dimension ``dim`` must
     belong to exactly one physical group (gmsh exports a cell once per group
     it belongs to).
+
+    cells: ``"triangle"`` or ``"quadrilateral"``: the surface cells of that shape alone. A DOLFINx
+    mesh holds one cell shape, so a surface meshed with both (gmsh's recombination where it
+    succeeds) is read twice, ``from_gmsh(model, 3, cells="triangle")`` and ``cells="quadrilateral"``,
+    and the shells added to both meshes share their common nodes. Point and line groups then
+    become node groups of the nodes they have in that mesh.
     """
     groups: dict[str, tuple[int, int]] = {}
     points: dict[str, np.ndarray] = {}
@@ -247,6 +253,11 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
             error = ("the gmsh node tags are not 1..n (the mesh's input node numbers are the tags − 1): call "
                      "gmsh.model.mesh.renumberNodes() before from_gmsh")
         tdim = max((d for d, _ in phys), default=0) if dim is None else int(dim)
+        if cells is not None:
+            tdim = 2
+        wanted = {None: None, "triangle": 2, "quadrilateral": 3}.get(cells, -1)
+        if wanted == -1:
+            error = f"cells = {cells!r} is not 'triangle' or 'quadrilateral'"
         if not error and not any(d == tdim for d, _ in phys):
             error = f"the gmsh model has no physical group of dimension {tdim} (cells to build a mesh of)"
         seen: dict[int, str] = {}
@@ -263,14 +274,25 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
                         seen[int(e)] = name
         # the nodes of the mesh: those of the cells (elements of the physical groups of dimension tdim)
         in_mesh = np.zeros(len(node_tags) + 1, dtype=bool)
+        shapes = set()
         for d, tag in phys:
             if d == tdim and not error:
                 for entity in model.getEntitiesForPhysicalGroup(d, tag):
-                    for enodes in model.mesh.getElements(d, entity)[2]:
-                        in_mesh[np.asarray(enodes, dtype=np.int64)] = True
+                    etypes, _, enodes_all = model.mesh.getElements(d, entity)
+                    for etype, enodes in zip(etypes, enodes_all):
+                        shapes.add(int(etype))
+                        if wanted is None or int(etype) == wanted:
+                            in_mesh[np.asarray(enodes, dtype=np.int64)] = True
+        if not error and tdim == 2 and cells is None and {2, 3} <= shapes:
+            error = ("the surface mesh has both triangles and quadrilaterals; a DOLFINx mesh holds one cell shape: "
+                     "read it as two meshes, from_gmsh(model, 3, cells='triangle') and from_gmsh(model, 3, "
+                     "cells='quadrilateral'), and add the shells (or membranes) to both: they share their "
+                     "common nodes")
+        if not error and wanted is not None and wanted not in shapes:
+            error = f"the gmsh model has no {cells} cells among its physical groups of dimension 2"
         # the mesh's facet tags come from the groups of dimension tdim − 1 (when tdim is the highest):
         # their elements must lie on the cells (DOLFINx cannot tag facets that are not the mesh's)
-        if not error and tdim == max(d for d, _ in phys):
+        if not error and tdim == max(d for d, _ in phys) and cells is None:
             for d, tag in phys:
                 if d != tdim - 1 or error:
                     continue
@@ -298,7 +320,7 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
                 nodes = np.asarray(nodes, dtype=np.int64)
                 used = in_mesh[nodes]
                 node_ids[name] = np.unique(nodes[used] - 1)  # input node number = gmsh tag − 1
-                if not np.all(used):  # e.g. a gmsh point not embedded in the surface: by position
+                if not np.all(used) and cells is None:  # e.g. a gmsh point not embedded in the surface: by position
                     points[name] = np.asarray(coords, dtype=float).reshape(-1, 3)[~used]
         # the model's name and a digest of all its nodes (tags and coordinates): reading one meshed
         # model twice (cells of two dimensions) gives one source; two meshes made in separate gmsh
@@ -319,12 +341,12 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
     tdim = comm.bcast(tdim, root=rank)
     top = max(d for d, _ in groups.values())
     facet_tags = None
-    if tdim == top:
+    if tdim == top and cells is None:
         from dolfinx.io import gmshio  # (gmsh is imported when a gmsh model is read)
 
         msh, cell_tags, facet_tags = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
     else:
-        msh, cell_tags = _lower_dimensional_mesh(model, comm, rank, gdim, tdim)
+        msh, cell_tags = _lower_dimensional_mesh(model, comm, rank, gdim, tdim, cells)
     ncells_local = msh.topology.index_map(tdim).size_local
     ncells = comm.allreduce(ncells_local, op=MPI.SUM)
     ntagged = comm.allreduce(int(np.sum(cell_tags.indices < ncells_local)), op=MPI.SUM)
@@ -333,13 +355,16 @@ def from_gmsh(model, gdim: int, comm: MPI.Comm = MPI.COMM_WORLD, rank: int = 0,
     return TaggedMesh(msh, cell_tags, groups, points, node_ids, node_source=source, facet_tags=facet_tags)
 
 
-def _lower_dimensional_mesh(model, comm: MPI.Comm, rank: int, gdim: int, tdim: int):
-    """The cells of dimension ``tdim`` < the model's highest as a mesh (linear lines or triangles);
-    its input node numbers are the gmsh node tags − 1, as for ``gmshio.model_to_mesh``."""
+def _lower_dimensional_mesh(model, comm: MPI.Comm, rank: int, gdim: int, tdim: int, shape: str | None = None):
+    """The cells of dimension ``tdim`` < the model's highest (linear lines or triangles), or the
+    surface cells of one ``shape`` ('triangle', 'quadrilateral'), as a mesh; its input node numbers
+    are the gmsh node tags − 1, as for ``gmshio.model_to_mesh``."""
     import ufl
 
     cell_name, gmsh_type = {1: ("interval", 1), 2: ("triangle", 2)}[tdim]
-    nv = tdim + 1
+    if shape == "quadrilateral":
+        cell_name, gmsh_type = "quadrilateral", 3
+    nv = {1: 2, 2: 3, 3: 4}[gmsh_type]
     if comm.rank == rank:
         tags, coords, _ = model.mesh.getNodes()
         order = np.argsort(tags)
@@ -353,10 +378,14 @@ def _lower_dimensional_mesh(model, comm: MPI.Comm, rank: int, gdim: int, tdim: i
             for entity in model.getEntitiesForPhysicalGroup(d, tag):
                 types, _, nodes = model.mesh.getElements(d, entity)
                 for t, n in zip(types, nodes):
+                    if shape is not None and t in (2, 3) and t != gmsh_type:
+                        continue  # the other shape of a mixed surface: a mesh of its own
                     if t != gmsh_type:
                         raise ValueError(f"physical group {tag} of dimension {d} has gmsh elements of type {t}; "
                                          f"only linear {cell_name}s (type {gmsh_type}) are read")
                     c = np.asarray(n, dtype=np.int64).reshape(-1, nv) - 1
+                    if nv == 4:
+                        c = c[:, [0, 1, 3, 2]]  # gmsh counter-clockwise → DOLFINx's tensor-product order
                     cells.append(c)
                     values.append(np.full(len(c), tag, dtype=np.int32))
         cells = np.concatenate(cells)

@@ -27,8 +27,11 @@
 # matters: the same three meshes are run with the OPT membrane (the default)
 # and with the constant-strain triangle plus a drilling penalty. Both
 # converge to the same curve, OPT from below and several times faster (the
-# CST locks in in-plane bending and converges from above). The published
-# curves of this benchmark are not checked here: the checks are
+# CST locks in in-plane bending and converges from above). The same grids are
+# also run with four-node shells (one quadrilateral per pair of triangles, the
+# same nodes: incompatible-mode membrane, discrete Kirchhoff bending), which
+# converge from above: OPT triangles and quadrilaterals bracket the curve. The
+# published curves of this benchmark are not checked here: the checks are
 # self-convergence.
 
 # %%
@@ -49,9 +52,11 @@ P_end = 40000.0
 
 def pullout(n_theta, n_x, w_max=3.0, steps=30, membrane="opt", demo=None):
     """(P, w_A, w_B, u_C) per step, the result and the wall time; with ``demo``, the cylinder at
-    w_A = 0.75, 1.5, 2.25 and 3 in ``cylinder_shapes.png``."""
+    w_A = 0.75, 1.5, 2.25 and 3 in ``cylinder_shapes.png``. membrane "opt" or "cst" (triangles),
+    "qm6" (quadrilaterals)."""
     scene = dc.Scene(large_rotations=True)
-    shell = scene.add_shell(cylinder_eighth(R, L, n_theta, n_x, comm=comm), "shell", thickness=t,
+    quads = membrane == "qm6"
+    shell = scene.add_shell(cylinder_eighth(R, L, n_theta, n_x, comm=comm, quads=quads), "shell", thickness=t,
                             material=dc.Elastic(E, nu), membrane=membrane)
     scene.fix(shell, "mid", dofs=("ux", "ry", "rz"))   # plane x = 0
     scene.fix(shell, "top", dofs=("uy", "rx", "rz"))   # plane y = 0
@@ -81,18 +86,18 @@ def at_wA(curve, w):
 
 
 # %% [markdown]
-# ## Three meshes (n_θ × n_x triangles pairs)
+# ## Three meshes (n_θ × n_x pairs of triangles, or quadrilaterals)
 #
 # `cylinder_shapes.png` draws the finest OPT model at $w_A$ = 0.8, 1.5, 2.3 and 3, coloured by $|u|$ over the initial eighth of the cylinder: the section is
 # pulled from a quarter circle into a flat band.
 
 # %%
 def three_meshes(demo):
-    """Per membrane, one row per mesh: (n_θ, n_x, P, w_B, u_C at w_A = 2.5, wall time, Newton
+    """Per element family, one row per mesh: (n_θ, n_x, P, w_B, u_C at w_A = 2.5, wall time, Newton
     iterations, cuts, last P); the OPT curves."""
     meshes = [(8, 12), (12, 18), (16, 24)] if demo.ci else [(8, 12), (16, 24), (24, 36)]
     studies, curves = {}, {}
-    for membrane in ("opt", "cst"):
+    for membrane in ("opt", "cst", "qm6"):
         rows = []
         for n_theta, n_x in meshes:
             finest_opt = membrane == "opt" and (n_theta, n_x) == meshes[-1]  # the picture of this run
@@ -101,22 +106,35 @@ def three_meshes(demo):
                 curves[(n_theta, n_x)] = curve
             d = at_wA(curve, W_CHECK)
             rows.append((n_theta, n_x, *d, wall, res.totals["newton_iterations"], res.totals["cuts"], curve[-1, 0]))
-            demo.say(f"{membrane.upper():3s} {n_theta:2d} x {n_x:2d}: at w_A = {W_CHECK}  P = {d[0]:.0f}, "
+            demo.say(f"{FAMILY[membrane]:>22s} {n_theta:2d} x {n_x:2d}: at w_A = {W_CHECK}  P = {d[0]:.0f}, "
                      f"w_B = {d[1]:.4f}, u_C = {d[2]:.4f}; P = {curve[-1, 0]:.0f} at w_A = 3; {wall:.1f} s, "
                      f"{res.totals['newton_iterations']} iterations, {res.totals['cuts']} cuts")
         studies[membrane] = np.array(rows)
     for membrane, st in studies.items():
         changes = np.abs(np.diff(st[:, 2])) / st[1:, 2]
-        demo.say(f"{membrane.upper()}: P at w_A = {W_CHECK} changes by "
+        demo.say(f"{FAMILY[membrane]}: P at w_A = {W_CHECK} changes by "
                  + ", ".join(f"{100 * c:.1f} %" for c in changes) + " from mesh to mesh")
-    demo.table("mesh_convergence.csv",
-               np.c_[np.r_[np.ones(len(meshes)), np.zeros(len(meshes))], np.vstack([studies["opt"], studies["cst"]])],
-               ["opt_membrane", "n_theta", "n_x", "P_at_wA_2.5", "wB_at_wA_2.5", "uC_at_wA_2.5", "wall_s",
+    family = np.repeat([0.0, 1.0, 2.0], len(meshes))
+    demo.table("mesh_convergence.csv", np.c_[family, np.vstack([studies[m] for m in ("opt", "cst", "qm6")])],
+               ["family_opt0_cst1_quad2", "n_theta", "n_x", "P_at_wA_2.5", "wB_at_wA_2.5", "uC_at_wA_2.5", "wall_s",
                 "iterations", "cuts", "P_last"])
-    opt = studies["opt"]
-    demo.work_precision_to_finest((opt[:, 0] * opt[:, 1]).astype(int), opt[:, 2], opt[:, 5],
-                                  quantity=f"P at w_A = {W_CHECK}, OPT membrane (cells n_θ × n_x)")
+    # OPT triangles converge from below and quadrilaterals from above: the mean of their finest runs
+    # is the reference of both curves
+    opt, quad = studies["opt"], studies["qm6"]
+    limit = 0.5 * (opt[-1, 2] + quad[-1, 2])
+    nodes = ((opt[:, 0] + 1) * (opt[:, 1] + 1)).astype(int)
+    for key, st in (("opt", opt), ("qm6", quad)):
+        demo.work_precision_to_finest(nodes, st[:, 2], st[:, 5], series=FAMILY[key], finest=limit,
+                                      finest_label="the mean of the finest OPT and quadrilateral runs",
+                                      quantity=f"P at w_A = {W_CHECK} (nodes)")
+    demo.say("same nodes, P at w_A = 2.5 against the mean of the finest runs ({:.0f}): ".format(limit)
+             + "; ".join(f"{int(n)} nodes: triangles {100 * (a / limit - 1):+.1f} %, quadrilaterals "
+                         f"{100 * (b / limit - 1):+.1f} %, time {tq / to:.2f} x"
+                         for n, a, b, to, tq in zip(nodes, opt[:, 2], quad[:, 2], opt[:, 5], quad[:, 5])))
     return studies, curves
+
+
+FAMILY = {"opt": "triangles (OPT)", "cst": "triangles (CST)", "qm6": "quadrilaterals (DKQ)"}
 
 
 def plot(demo, curves):
@@ -143,26 +161,33 @@ def main() -> dict:
     studies, curves = three_meshes(demo)
     plot(demo, curves)
     for membrane, st in studies.items():
-        demo.check(f"{membrane.upper()}: force at w_A = 3, every mesh (P = 40 000 reached)", st[:, 8],
+        name = FAMILY[membrane]
+        demo.check(f"{name}: force at w_A = 3, every mesh (P = 40 000 reached)", st[:, 8],
                    bound=(P_end, None), reference="the seed's load range (P up to 40 000)")
-        demo.check(f"{membrane.upper()}: failed load steps, every mesh", st[:, 7], 0,
+        demo.check(f"{name}: failed load steps, every mesh", st[:, 7], 0,
                    reference="solver acceptance (no published value)")
         d_coarse = np.abs(st[1, 2:5] - st[0, 2:5])
         d_fine = np.abs(st[2, 2:5] - st[1, 2:5])
-        demo.check(f"{membrane.upper()}: change of (P, w_B, u_C) at w_A = 2.5 on the last refinement minus the "
+        demo.check(f"{name}: change of (P, w_B, u_C) at w_A = 2.5 on the last refinement minus the "
                    "first (the curve converges with the mesh)", d_fine - d_coarse, bound=(None, 0.0),
                    reference=SELF)
-    opt, cst = studies["opt"], studies["cst"]
+    opt, cst, quad = studies["opt"], studies["cst"], studies["qm6"]
     demo.check("OPT: relative change of P at w_A = 2.5 on the last refinement", abs(opt[2, 2] - opt[1, 2]) / opt[2, 2],
                bound=0.02, reference=SELF)
     demo.check("OPT: increase of P at w_A = 2.5 from mesh to mesh (from below)", np.diff(opt[:, 2]),
                bound=(0.0, None), reference=SELF)
     demo.check("CST: change of P at w_A = 2.5 from mesh to mesh (from above)", np.diff(cst[:, 2]),
                bound=(None, 0.0), reference=SELF)
+    demo.check("quadrilaterals: change of P at w_A = 2.5 from mesh to mesh (from above)", np.diff(quad[:, 2]),
+               bound=(None, 0.0), reference=SELF)
+    demo.check("P at w_A = 2.5, quadrilaterals minus OPT triangles on the same nodes, every mesh (they bracket "
+               "the converged force)", quad[:, 2] - opt[:, 2], bound=(0.0, None), reference=SELF)
     demo.check("last change of P, OPT / CST (OPT converges faster)",
                abs(opt[2, 2] - opt[1, 2]) / abs(cst[2, 2] - cst[1, 2]), bound=0.5, reference=SELF)
     demo.check("OPT against CST on the finest mesh: P at w_A = 2.5 (to the same force)", cst[2, 2], opt[2, 2],
                rtol=0.1, reference=SELF)
+    demo.check("quadrilaterals against OPT triangles on the finest mesh: P at w_A = 2.5", quad[2, 2], opt[2, 2],
+               rtol=0.025, reference=SELF)
     return demo.finish()
 
 

@@ -144,30 +144,46 @@ class Demo:
         self.pictures.append(filename)
 
     def work_precision(self, resolution: Sequence, error: Sequence[float], time: Sequence[float], *,
-                       quantity: str, reference: str) -> None:
+                       quantity: str, reference: str, series: str | None = None) -> None:
         """What accuracy costs: the relative ``error`` of ``quantity`` (against ``reference``) and the
         wall ``time`` of each run, mesh by mesh (``resolution``: elements, nodes or dofs), to
         ``<out>/work_precision.json`` on rank 0; the documentation gathers every demo's in one
-        plot (accuracy against time). Runs whose error is not a number are left out."""
+        plot (accuracy against time). Runs whose error is not a number are left out. ``series``
+        names one of several element families of the demo (e.g. "triangles", "quadrilaterals"):
+        each call with a series adds a curve to the demo's file."""
         if not (len(resolution) == len(error) == len(time)):
             raise ValueError("work_precision: resolution, error and time need one entry per run")
         keep = [k for k, e in enumerate(error) if np.isfinite(float(e))]  # runs without a value are left out
+        data = {"quantity": quantity, "reference": reference,
+                "resolution": [_plain(resolution[k]) for k in keep],
+                "error": [abs(float(error[k])) for k in keep], "time": [float(time[k]) for k in keep]}
+        if series is None:
+            self._series = []
+        else:
+            self._series = [s for s in getattr(self, "_series", []) if s["series"] != series]
+            self._series.append({"series": series, **data})
+            data = {"series": self._series}
         if self.rank == 0:
             with open(self.path("work_precision.json"), "w") as f:
-                json.dump({"quantity": quantity, "reference": reference,
-                           "resolution": [_plain(resolution[k]) for k in keep],
-                           "error": [abs(float(error[k])) for k in keep], "time": [float(time[k]) for k in keep]}, f,
-                          indent=1)
+                json.dump(data, f, indent=1)
 
     def work_precision_to_finest(self, resolution: Sequence, value: Sequence[float], time: Sequence[float], *,
-                                 quantity: str) -> None:
+                                 quantity: str, series: str | None = None, finest: float | None = None,
+                                 finest_label: str | None = None) -> None:
         """:meth:`work_precision` of a self-convergence study: the error of each run is its relative
-        distance from the finest run's ``value`` (the finest run itself left out of the plot)."""
+        distance from the finest run's ``value`` (the finest run itself left out of the plot), or
+        from ``finest`` (e.g. another family's finest run, named by ``finest_label``; then every
+        run is kept)."""
         value = np.asarray(value, dtype=float)
-        error = np.abs(value / value[-1] - 1.0)
-        error[-1] = np.nan
-        self.work_precision(resolution, error, time, quantity=quantity,
-                            reference=f"self-convergence: the finest run ({_plain(resolution[-1])})")
+        if finest is None:
+            error = np.abs(value / value[-1] - 1.0)
+            error[-1] = np.nan
+            label = f"the finest run ({_plain(resolution[-1])})"
+        else:
+            error = np.abs(value / float(finest) - 1.0)
+            label = finest_label or f"the value {finest:g}"
+        self.work_precision(resolution, error, time, quantity=quantity, reference=f"self-convergence: {label}",
+                            series=series)
 
     def table(self, filename: str, rows: Union[Sequence[dict], np.ndarray],
               columns: Optional[Sequence[str]] = None) -> None:

@@ -174,7 +174,9 @@ def accuracy_page(names: list[str]) -> None:
     for name in names:
         path = OUTPUT / name / "work_precision.json"
         if path.exists():
-            series.append((name, json.loads(path.read_text())))
+            data = json.loads(path.read_text())
+            for part in data.get("series", [data]):  # one curve, or one per element family
+                series.append((f"{name} ({part['series']})" if "series" in part else name, part))
     lines = ["# Accuracy against time", "",
              "What accuracy costs: each demo that refines its mesh reports the error of its verified "
              "quantity against the wall time of the run, mesh by mesh (shortened runs, one core; the "
@@ -199,7 +201,7 @@ def accuracy_page(names: list[str]) -> None:
             errs = ", ".join(f"{e:.2g}" for e in data["error"])
             times = ", ".join(f"{t:.2g}" for t in data["time"])
             meshes = ", ".join(str(m) for m in data["resolution"])
-            lines.append(f"| [{name}](gallery/{name}) | {data['quantity']} | {data['reference']} | {meshes} | "
+            lines.append(f"| [{name}](gallery/{name.split(' ')[0]}) | {data['quantity']} | {data['reference']} | {meshes} | "
                          f"{errs} | {times} |")
     else:
         lines += ["No demo has written work-precision data yet."]

@@ -172,6 +172,7 @@ def main() -> dict:
                    "first (the curve converges with the mesh)", d_fine - d_coarse, bound=(None, 0.0),
                    reference=SELF)
     opt, cst, quad = studies["opt"], studies["cst"], studies["qm6"]
+    demo.record(quad_P_at_wA=quad[:, 2], quad_wB_at_wA=quad[:, 3])
     demo.check("OPT: relative change of P at w_A = 2.5 on the last refinement", abs(opt[2, 2] - opt[1, 2]) / opt[2, 2],
                bound=0.02, reference=SELF)
     demo.check("OPT: increase of P at w_A = 2.5 from mesh to mesh (from below)", np.diff(opt[:, 2]),

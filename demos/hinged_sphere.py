@@ -148,6 +148,7 @@ def main() -> dict:
     quad, quad_curves = three_meshes(demo, quads=True)
     plot(demo, study, curves)
     limit = work_precision(demo, study, quad)
+    demo.record(quad_P_max=quad[:, 1])
     solver = "solver acceptance (no published value)"
     ours = "the snap-through of the cap (our data, seed §2.4.2)"
     self_conv = "self-convergence (no published value)"

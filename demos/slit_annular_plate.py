@@ -150,6 +150,7 @@ def main() -> dict:
     quad, _ = three_meshes(demo, quads=True)
     plot(demo, hists)
     limit = work_precision(demo, study, quad)
+    demo.record(quad_wA=quad[:, 2], quad_wB=quad[:, 3])
     for st, family in ((study, "triangles"), (quad, "quadrilaterals")):
         demo.check(f"{family}: cut load steps, every mesh (retried from the last converged state)", st[:, 6],
                    bound=12, reference="solver acceptance (no published value)")

@@ -198,6 +198,7 @@ def main() -> dict:
     rows, hist, rates = three_meshes(demo)
     quad_rows, _, quad_rates = three_meshes(demo, quads=True)
     plot(demo, rows, hist)
+    demo.record(quad_tip_error_L=[r["tip_error_L"] for r in quad_rows])
     for rs, rt, family in ((rows, rates, "triangles"), (quad_rows, quad_rates, "quadrilaterals")):
         warp = [r["section_warp_L"] for r in rs]
         demo.check(f"{family}: tip error / L at the full circle, {meshes[-1]} x 2 squares", rs[-1]["tip_error_L"],

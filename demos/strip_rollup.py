@@ -178,6 +178,7 @@ def main() -> dict:
     demo = Demo("strip_rollup")
     result, err = full_circle(demo, strip_scene(demo))
     rows = families(demo)
+    demo.record(quad_error_max_L=[r["error_max_L"] for r in rows if r["quads"]])
     tri = [r for r in rows if not r["quads"]]
     quad = [r for r in rows if r["quads"]]
     demo.check("quadrilaterals: tip error / L at the full circle, 8, 16, 32 squares", [r["error_end_L"] for r in quad],

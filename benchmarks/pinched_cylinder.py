@@ -15,8 +15,9 @@ hop is a drop (arc length shows them as snap-backs of the discrete model). The s
 per mesh: the drops (count, count above 1 %, largest), where the run ended, P at w = 40, 60, 80,
 Newton iterations and wall time; writes output/pinched_cylinder_bench/{bench.json, curves.csv,
 curves.png}.
+With --quads the same grids carry four-node shells (discrete Kirchhoff quadrilaterals).
 Usage: python benchmarks/pinched_cylinder.py [--meshes 10x10 24x24 40x16] [--steps 80] [--w-max 80]
-       [--tangent auto|consistent] [--rtol 1e-9]
+       [--tangent auto|consistent] [--rtol 1e-9] [--quads]
 """
 import argparse
 import json
@@ -34,16 +35,17 @@ comm = MPI.COMM_WORLD
 R, L, T, E, NU = 100.0, 200.0, 1.0, 3.0e4, 0.3
 
 
-def octant(n_theta: int, n_x: int):
+def octant(n_theta: int, n_x: int, quads: bool = False):
     """Nodes on the octant x ∈ [0, L/2], θ ∈ [0, π/2] (from the loaded point (0, 0, R) towards y),
-    right-diagonal triangles, and the node groups of the conditions."""
+    right-diagonal triangles (or the quadrilaterals of the grid), and the node groups of the
+    conditions."""
     th = np.linspace(0.0, 0.5 * np.pi, n_theta + 1)
     xs = np.linspace(0.0, 0.5 * L, n_x + 1)
     TH, XS = np.meshgrid(th, xs, indexing="ij")
     points = np.c_[XS.ravel(), R * np.sin(TH.ravel()), R * np.cos(TH.ravel())]
     node = np.arange(len(points)).reshape(n_theta + 1, n_x + 1)
     a, b, c, d = node[:-1, :-1].ravel(), node[:-1, 1:].ravel(), node[1:, 1:].ravel(), node[1:, :-1].ravel()
-    cells = np.r_[np.c_[a, b, c], np.c_[a, c, d]]
+    cells = np.c_[a, b, c, d] if quads else np.r_[np.c_[a, b, c], np.c_[a, c, d]]
     groups = {"mid": node[:, 0], "top": node[0, :], "side": node[-1, :], "end": node[:, -1], "A": node[:1, 0]}
     return points, cells, groups
 
@@ -55,9 +57,10 @@ def load_drops(P: np.ndarray) -> np.ndarray:
     return fall[fall > 0.0] / before[fall > 0.0]
 
 
-def run(n_theta: int, n_x: int, steps: int, w_max: float, tangent: str = "auto", rtol: float = 1e-9) -> dict:
+def run(n_theta: int, n_x: int, steps: int, w_max: float, tangent: str = "auto", rtol: float = 1e-9,
+        quads: bool = False) -> dict:
     scene = dc.Scene(tangent=tangent)
-    points, cells, groups = octant(n_theta, n_x)
+    points, cells, groups = octant(n_theta, n_x, quads)
     shell = scene.add_shell(from_arrays(points, cells, "shell", groups, comm=comm), "shell",
                             thickness=T, material=dc.Elastic(E, NU))
     scene.fix(shell, "mid", dofs=("ux", "ry", "rz"))   # plane x = 0
@@ -77,7 +80,7 @@ def run(n_theta: int, n_x: int, steps: int, w_max: float, tangent: str = "auto",
     P = -4.0 * res.history.column("A_Fz")
     w = w_max * res.history.column("load_factor")
     falls = load_drops(P)
-    return {"mesh": f"{n_theta}x{n_x}", "steps_done": len(P), "w_end": float(w[-1]), "ended": ended,
+    return {"mesh": f"{n_theta}x{n_x}" + (" quadrilaterals" if quads else ""), "steps_done": len(P), "w_end": float(w[-1]), "ended": ended,
             "drops": int(len(falls)), "drops_over_1pc": int(np.sum(falls > 0.01)),
             "largest_drop_pc": float(100.0 * falls.max()) if len(falls) else 0.0,
             **{f"P_at_w{int(x)}": float(np.interp(x, w, P)) if w[-1] >= x else None for x in (40, 60, 80)},
@@ -92,12 +95,13 @@ def main():
     ap.add_argument("--w-max", type=float, default=80.0)
     ap.add_argument("--tangent", default="auto", help="auto, consistent or symmetrized")
     ap.add_argument("--rtol", type=float, default=1e-9, help="Newton's residual tolerance")
+    ap.add_argument("--quads", action="store_true", help="four-node shells on the same grids")
     args = ap.parse_args()
     out = output_dir("pinched_cylinder_bench")
     rows = []
     for mesh in args.meshes:
         n_theta, n_x = (int(v) for v in mesh.split("x"))
-        r = run(n_theta, n_x, args.steps, args.w_max, args.tangent, args.rtol)
+        r = run(n_theta, n_x, args.steps, args.w_max, args.tangent, args.rtol, args.quads)
         rows.append(r)
         if comm.rank == 0:
             print(f"{r['mesh']:>6}: {r['drops']} drops ({r['drops_over_1pc']} over 1 %, largest "

@@ -217,3 +217,42 @@ def test_the_readme_laminate_example_runs_and_bends_as_a_laminated_strip():
     P, L, b = 10.0, space["L"], space["b"]
     stiff, soft = P * L**3 / (3 * b * D[0, 0]), P * L**3 / (3 * b / np.linalg.inv(D)[0, 0])
     assert stiff < w < soft
+
+
+@pytest.mark.parametrize("kind", ["quad", "triangle", "quad_with_shells"])
+def test_orthotropic_membrane_in_uniaxial_tension_off_its_axes(kind):
+    """A square membrane of an orthotropic fabric (warp at 30° from x, E1/E2 = 25) pulled by a
+    uniform edge tension Nx: its mid-surface strains are A⁻¹(Nx, 0, 0) with A turned by 30°
+    (shear coupling included), exactly on any mesh (constant strain), geometrically linear:
+    1e-8. On triangles (CST), quadrilaterals (Q4), and quadrilaterals of a mesh that also
+    carries shells (the shell's membrane)."""
+    a, t, Nx, nx = 1.0, 0.01, 1.0, 4
+    angle = np.radians(30.0)
+    axis = (np.cos(angle), np.sin(angle), 0.0)
+    fabric = dc.Orthotropic(E1=25 * E2, E2=E2, G12=0.5 * E2, nu12=0.25)
+    A = dc.Laminate.single(t, fabric).matrices(angle)[0][0]
+    exx, eyy, gxy = np.linalg.solve(A, [Nx, 0.0, 0.0])
+    tm = _plate(a, a, nx, nx, "triangle" if kind == "triangle" else "quad")
+    sc = dc.Scene(large_rotations=False)
+    if kind == "quad_with_shells":  # a shell on one cell makes the mesh a four-node shell part
+        tm.add_cell_group("corner_cell", lambda x: (x[0] < a / nx) & (x[1] < a / nx))
+        tm.add_cell_group("rest", lambda x: ~((x[0] < a / nx) & (x[1] < a / nx)))
+        sc.add_shell(tm, "corner_cell", thickness=t, material=fabric, axis=axis)
+        p = sc.add_membrane(tm, "rest", thickness=t, material=fabric, axis=axis)
+    else:
+        p = sc.add_membrane(tm, "plate", thickness=t, material=fabric, axis=axis)
+    sc.fix(p, "plate", dofs=("uz",))  # a flat membrane has no stiffness out of its plane
+    sc.fix(p, "corner", dofs=("ux", "uy"))
+    sc.fix(p, "y1", dofs=("ux",))
+    for x_edge, sign in ((a, 1.0), (0.0, -1.0)):
+        for j, y in enumerate(np.linspace(0, a, nx + 1)):
+            name = f"e{int(x_edge)}_{j}"
+            tm.add_point_group(name, [[x_edge, y, 0.0]])
+            sc.load(p, name, force=(sign * Nx * a / nx * (0.5 if j in (0, nx) else 1.0), 0.0, 0.0))
+    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
+    X, u = p.model.nodes()
+    x, y = X[:, 0], X[:, 1]
+    # u = εx x + (γ/2 − ω) y, v = εy y + (γ/2 + ω) x; the rigid rotation ω is set by u(0, a) = 0
+    omega = 0.5 * gxy
+    np.testing.assert_allclose(u[:, 0], exx * x + (0.5 * gxy - omega) * y, atol=1e-8 * exx * a)
+    np.testing.assert_allclose(u[:, 1], eyy * y + (0.5 * gxy + omega) * x, atol=1e-8 * exx * a)

@@ -886,6 +886,12 @@ def _staged_3d_scene(kind: str):
         tm = from_arrays(points, cells, cell_name="shell", point_groups={"edge": np.array([0, 3, 6])}, comm=comm)
         part = sc.add_shell(tm, "shell", thickness=0.05, material=dc.Elastic(2.0e4, 0.3))
         sc.fix(part, "edge")
+    elif kind == "quad_shell":  # four-node shells (DKQ) on a warped sheet
+        points = np.array([[x, y, 0.1 * x * y] for y in (0.0, 0.5, 1.0) for x in (0.0, 0.5, 1.0)])
+        cells = np.array([[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]])
+        tm = from_arrays(points, cells, cell_name="shell", point_groups={"edge": np.array([0, 3, 6])}, comm=comm)
+        part = sc.add_shell(tm, "shell", thickness=0.05, material=dc.Elastic(2.0e4, 0.3))
+        sc.fix(part, "edge")
     else:  # quadrilateral membranes on a warped sheet
         points = np.array([[x, y, 0.1 * x * y] for y in (0.0, 0.5, 1.0) for x in (0.0, 0.5, 1.0)])
         cells = np.array([[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]])
@@ -896,9 +902,9 @@ def _staged_3d_scene(kind: str):
 
 
 @pytest.mark.skipif(comm.size > 1, reason="dense finite differences of the assembled system: serial")
-@pytest.mark.parametrize("kind", ["beam", "shell", "membrane"])
+@pytest.mark.parametrize("kind", ["beam", "shell", "quad_shell", "membrane"])
 def test_staged_3d_tangent_matches_finite_differences(kind):
-    """3D beams, shell triangles and quadrilateral membranes added undeformed in a deformed configuration (approach II:
+    """3D beams, shell triangles, four-node shells and quadrilateral membranes added undeformed in a deformed configuration (approach II:
     reference X + u_a, states since then (u − u_a, R R_aᵀ), a the memorized states): added at
     random states (0.3 in translation, rotations up to 2 rad about any axis) they carry no
     internal force (1e-12); moved on from there (0.1, 0.3 rad), their tangent against central

@@ -135,55 +135,64 @@ def basic(X, u, xbar0, dbar, B):
 # (12 evaluations of a few cross products) in :func:`shell_force_and_tangent`.
 
 
+@numba.njit(cache=True, inline="always")
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
 @numba.njit(cache=True)
 def shape_spin(y, Om):
     """Om (3, 24): the frame spin in the frame's own axes, ω = Ω δd^l, for nodes at y (4, 3) and
     variations δd^l (6 per node) in the frame's components. A function of the shape of y alone
-    (invariant under rigid motions of y), complex-analytic."""
-    dt = y.dtype
-    R = np.empty((3, 3), dtype=dt)
-    frame(y, R)
-    d1 = y[2] - y[0]
-    d2 = y[3] - y[1]
-    n = np.empty(3, dtype=dt)
-    cross(d1, d2, n)
-    nn = np.sqrt(dot(n, n))
-    l1 = np.sqrt(dot(d1, d1))
-    l2 = np.sqrt(dot(d2, d2))
-    h1 = d1 / l1
-    h2 = d2 / l2
-    m = h1 - h2
-    mm = np.sqrt(dot(m, m))
-    e1 = R[:, 0].copy()
-    e2 = R[:, 1].copy()
-    p1 = np.empty(3, dtype=dt)
-    p2 = np.empty(3, dtype=dt)
-    q1 = np.empty(3, dtype=dt)
-    q2 = np.empty(3, dtype=dt)
-    cross(d2, e2, p1)
-    cross(e2, d1, p2)
-    cross(d2, e1, q1)
-    cross(e1, d1, q2)
-    s1 = (e2 - dot(e2, h1) * h1) / l1
-    s2 = -(e2 - dot(e2, h2) * h2) / l2
-    # rows of ω against the global δd1 = δu3 − δu1, δd2 = δu4 − δu2, then turned to local columns
-    g = np.empty((3, 2, 3), dtype=dt)
-    for k in range(3):
-        g[0, 0, k] = -p1[k] / nn
-        g[0, 1, k] = -p2[k] / nn
-        g[1, 0, k] = q1[k] / nn
-        g[1, 1, k] = q2[k] / nn
-        g[2, 0, k] = s1[k] / mm
-        g[2, 1, k] = s2[k] / mm
+    (invariant under rigid motions of y), complex-analytic; scalar arithmetic (no arrays made:
+    the tangent calls it twelve times)."""
+    d10, d11, d12 = y[2, 0] - y[0, 0], y[2, 1] - y[0, 1], y[2, 2] - y[0, 2]
+    d20, d21, d22 = y[3, 0] - y[1, 0], y[3, 1] - y[1, 1], y[3, 2] - y[1, 2]
+    n0, n1, n2 = _cross(d10, d11, d12, d20, d21, d22)
+    nn = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+    l1 = np.sqrt(d10 * d10 + d11 * d11 + d12 * d12)
+    l2 = np.sqrt(d20 * d20 + d21 * d21 + d22 * d22)
+    h10, h11, h12 = d10 / l1, d11 / l1, d12 / l1
+    h20, h21, h22 = d20 / l2, d21 / l2, d22 / l2
+    m0, m1, m2 = h10 - h20, h11 - h21, h12 - h22
+    mm = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+    a0, a1, a2 = m0 / mm, m1 / mm, m2 / mm           # e1
+    c0, c1, c2 = n0 / nn, n1 / nn, n2 / nn           # e3
+    b0, b1, b2 = _cross(c0, c1, c2, a0, a1, a2)      # e2 = e3 × e1
+    # rows of ω against the global δd1 = δu3 − δu1 (s = 0) and δd2 = δu4 − δu2 (s = 1)
+    p10, p11, p12 = _cross(d20, d21, d22, b0, b1, b2)
+    p20, p21, p22 = _cross(b0, b1, b2, d10, d11, d12)
+    q10, q11, q12 = _cross(d20, d21, d22, a0, a1, a2)
+    q20, q21, q22 = _cross(a0, a1, a2, d10, d11, d12)
+    t1 = b0 * h10 + b1 * h11 + b2 * h12
+    t2 = b0 * h20 + b1 * h21 + b2 * h22
+    s10, s11, s12 = (b0 - t1 * h10) / l1, (b1 - t1 * h11) / l1, (b2 - t1 * h12) / l1
+    s20, s21, s22 = -(b0 - t2 * h20) / l2, -(b1 - t2 * h21) / l2, -(b2 - t2 * h22) / l2
     for i in range(3):
         for c in range(24):
             Om[i, c] = 0.0
-        for s in range(2):
-            for k in range(3):
-                acc = g[i, s, 0] * R[0, k] + g[i, s, 1] * R[1, k] + g[i, s, 2] * R[2, k]
-                # d1: nodes 3 (+) and 1 (−); d2: nodes 4 (+) and 2 (−)
-                Om[i, 6 * (2 + s) + k] += acc
-                Om[i, 6 * s + k] -= acc
+    for k in range(3):  # local column k: the global row vectors projected on e_k
+        if k == 0:
+            e0, e1, e2 = a0, a1, a2
+        elif k == 1:
+            e0, e1, e2 = b0, b1, b2
+        else:
+            e0, e1, e2 = c0, c1, c2
+        w = (-(p10 * e0 + p11 * e1 + p12 * e2) / nn, -(p20 * e0 + p21 * e1 + p22 * e2) / nn)
+        Om[0, 12 + k] += w[0]
+        Om[0, k] -= w[0]
+        Om[0, 18 + k] += w[1]
+        Om[0, 6 + k] -= w[1]
+        w = ((q10 * e0 + q11 * e1 + q12 * e2) / nn, (q20 * e0 + q21 * e1 + q22 * e2) / nn)
+        Om[1, 12 + k] += w[0]
+        Om[1, k] -= w[0]
+        Om[1, 18 + k] += w[1]
+        Om[1, 6 + k] -= w[1]
+        w = ((s10 * e0 + s11 * e1 + s12 * e2) / mm, (s20 * e0 + s21 * e1 + s22 * e2) / mm)
+        Om[2, 12 + k] += w[0]
+        Om[2, k] -= w[0]
+        Om[2, 18 + k] += w[1]
+        Om[2, 6 + k] -= w[1]
 
 
 @numba.njit(cache=True)

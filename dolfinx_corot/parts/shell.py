@@ -179,7 +179,8 @@ class Surface3D(Rotations3D, LineFrame):
             out = np.tile(head, (len(cells), 1))
             for slot, m in zip(slots, section.matrices(angles)):
                 if slot is not None and (bending or slot == slots[0]):
-                    out[:, slot:slot + m[0].size] = m.reshape(len(cells), -1)
+                    size = m.shape[1] * m.shape[2]  # (a rank may hold none of the group's cells)
+                    out[:, slot:slot + size] = m.reshape(len(cells), size)
             return out
         return rows
 

@@ -129,6 +129,29 @@ class Surface3D(Rotations3D, LineFrame):
         """The thickness."""
         return self.cell_properties(cells)[:, 2]
 
+    membrane_A0: int = 0  # where a membrane's A sits in the cells' properties (set per kind)
+
+    def add_membrane(self, where, section, axis=None):
+        """Membranes on group ``where``: the section's membrane stiffness A alone (see
+        :meth:`dolfinx_corot.Scene.add_membrane`); the kind's properties hold E, ν, t first."""
+        E, nu = self._reference_modulus(section)
+        head = np.zeros(self.nprops)
+        head[:3] = E, nu, section.thickness
+        rows = self._section_rows(head, section, axis, (self.membrane_A0, None, None, None), False)
+        return self.add_elements(where, rows, False, "membrane", self._fingerprint(head, section, axis))
+
+    def _check_geometry(self, cells, label, props):
+        """Refuse cells of zero size or area; quadrilaterals also self-intersecting, not convex,
+        with three corners on a line or strongly warped (MeshError naming the first; see
+        :func:`dolfinx_corot.parts.cells.triangle_problems`, :func:`~.cells.quadrilateral_problems`)."""
+        mesh = self.tmesh.mesh
+        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, self.nodes_per_cell)[cells]]
+        if self.nodes_per_cell == 4:
+            problems = quadrilateral_problems(X[:, CCW], mesh_extent(mesh))
+        else:
+            problems = triangle_problems(X, mesh_extent(mesh))
+        refuse(mesh, label, [(problem, cells[bad]) for problem, bad in problems])
+
     # -- sections: laminates and material axes ----------------------------------------------
     def _initial_axes(self, cells: np.ndarray):
         """(e1, e2, e3, centroid), each (n, 3): the initial element frames of local cells
@@ -209,6 +232,7 @@ class Shell3D(Surface3D):
 
     nodes_per_cell = 3
     nprops = shell_law.NPROPS
+    membrane_A0 = shell_law.A0
     kernels = OnFirstUse("shell3d")
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
@@ -234,20 +258,6 @@ class Shell3D(Surface3D):
         rows = self._section_rows(head, section, axis, (shell_law.A0, shell_law.B0, shell_law.D0), True)
         return self.add_elements(where, rows, True, "shell", self._fingerprint(head, section, axis))
 
-    def add_membrane(self, where, section, axis=None):
-        E, nu = self._reference_modulus(section)
-        head = np.zeros(shell_law.NPROPS)
-        head[:3] = E, nu, section.thickness
-        rows = self._section_rows(head, section, axis, (shell_law.A0, None, None), False)
-        return self.add_elements(where, rows, False, "membrane", self._fingerprint(head, section, axis))
-
-    def _check_geometry(self, cells, label, props):
-        """Refuse triangles of zero size or area (MeshError naming the first)."""
-        mesh = self.tmesh.mesh
-        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 3)[cells]]
-        problems = triangle_problems(X, mesh_extent(mesh))
-        refuse(mesh, label, [(problem, cells[bad]) for problem, bad in problems])
-
 
 class ShellQuad(Surface3D):
     """Four-node co-rotational shells on a quadrilateral mesh in space (see
@@ -258,6 +268,7 @@ class ShellQuad(Surface3D):
 
     nodes_per_cell = 4
     nprops = quad_shell_law.NPROPS
+    membrane_A0 = quad_shell_law.A0
     kernels = OnFirstUse("shell_quad")
 
     def add_shell(self, where, section, drilling: float, membrane: str | None = None, kinematics: str = "kirchhoff",
@@ -278,22 +289,6 @@ class ShellQuad(Surface3D):
         rows = self._section_rows(head, section, axis, slots, True)
         return self.add_elements(where, rows, True, "shell", self._fingerprint(head, section, axis))
 
-    def add_membrane(self, where, section, axis=None):
-        E, nu = self._reference_modulus(section)
-        head = np.zeros(quad_shell_law.NPROPS)
-        head[:3] = E, nu, section.thickness
-        rows = self._section_rows(head, section, axis, (quad_shell_law.A0, None, None, None), False)
-        return self.add_elements(where, rows, False, "membrane", self._fingerprint(head, section, axis))
-
-    def _check_geometry(self, cells, label, props):
-        """Refuse quadrilaterals of zero size or area, self-intersecting, not convex, with three
-        corners on a line or strongly warped (MeshError naming the first; see
-        :func:`dolfinx_corot.parts.cells.quadrilateral_problems`)."""
-        mesh = self.tmesh.mesh
-        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 4)[cells][:, CCW]]
-        problems = quadrilateral_problems(X, mesh_extent(mesh))
-        refuse(mesh, label, [(problem, cells[bad]) for problem, bad in problems])
-
 
 class MembraneQuad(Surface3D):
     """Four-node co-rotational membranes on a quadrilateral mesh in space; dofs (ux, uy, uz, rx,
@@ -302,25 +297,10 @@ class MembraneQuad(Surface3D):
 
     nodes_per_cell = 4
     nprops = quad_law.NPROPS
+    membrane_A0 = quad_law.A0
     kernels = OnFirstUse("membrane_quad")
 
     def add_shell(self, where, section, drilling, membrane=None, kinematics="kirchhoff", axis=None) -> PartRef:
         raise ValueError(f"shell '{where}': this quadrilateral mesh was given membranes first, which made it a "
                          "part of membranes alone (bilinear Q4); add its shells before its membranes, so that "
                          "the mesh carries four-node shells and its membranes are the shell's membrane")
-
-    def add_membrane(self, where, section, axis=None):
-        E, nu = self._reference_modulus(section)
-        head = np.zeros(quad_law.NPROPS)
-        head[:3] = E, nu, section.thickness
-        rows = self._section_rows(head, section, axis, (quad_law.A0, None, None), False)
-        return self.add_elements(where, rows, False, "membrane", self._fingerprint(head, section, axis))
-
-    def _check_geometry(self, cells, label, props):
-        """Refuse quadrilaterals of zero size or area, self-intersecting, not convex, with three
-        corners on a line or strongly warped (MeshError naming the first; see
-        :func:`dolfinx_corot.parts.cells.quadrilateral_problems`)."""
-        mesh = self.tmesh.mesh
-        X = mesh.geometry.x[mesh.geometry.dofmap.array.reshape(-1, 4)[cells][:, CCW]]
-        problems = quadrilateral_problems(X, mesh_extent(mesh))
-        refuse(mesh, label, [(problem, cells[bad]) for problem, bad in problems])

@@ -256,3 +256,20 @@ def test_orthotropic_membrane_in_uniaxial_tension_off_its_axes(kind):
     omega = 0.5 * gxy
     np.testing.assert_allclose(u[:, 0], exx * x + (0.5 * gxy - omega) * y, atol=1e-8 * exx * a)
     np.testing.assert_allclose(u[:, 1], eyy * y + (0.5 * gxy + omega) * x, atol=1e-8 * exx * a)
+
+
+def test_bad_sections_are_named():
+    """An orthotropic section without a material axis, an axis normal to the shell, a section given
+    together with a thickness, and a ply of an unknown material: each a clear error naming the part."""
+    tm = _plate(1.0, 1.0, 2, 2, "quad")
+    lam = cross_ply(0.01, (0, 90, 90, 0))
+    with pytest.raises(ValueError, match="shell 'plate'.*orthotropic plies: give the material axis"):
+        dc.Scene().add_shell(tm, "plate", section=lam)
+    with pytest.raises(ValueError, match="shell 'plate'.*material axis is normal to 4 cell"):
+        dc.Scene().add_shell(tm, "plate", section=lam, axis=(0.0, 0.0, 1.0))
+    with pytest.raises(ValueError, match="membrane 'plate': give either section=dc.Laminate"):
+        dc.Scene().add_membrane(tm, "plate", thickness=0.01, section=lam)
+    with pytest.raises(TypeError, match="Ply: material must be dc.Orthotropic or dc.Elastic"):
+        dc.Ply(0.01, 0.0, "steel")
+    with pytest.raises(ValueError, match="Orthotropic: nu12 = 6.0 makes the layer unstable"):
+        dc.Orthotropic(E1=1.0, E2=1.0, G12=0.5, nu12=6.0)

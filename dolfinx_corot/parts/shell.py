@@ -184,8 +184,8 @@ class Surface3D(Rotations3D, LineFrame):
                              f"(n, 3) giving (n, 3) vectors; got shape {a.shape}")
         a1, a2 = np.einsum("ni,ni->n", a, e1), np.einsum("ni,ni->n", a, e2)
         bad = np.flatnonzero(np.hypot(a1, a2) <= 1e-6 * np.linalg.norm(a, axis=1))
-        refuse(self.tmesh.mesh, label, [("the material axis is normal to {n} cell(s), the first at {at}: "
-                                         "give an axis that lies in the shell", cells[bad])], ValueError)
+        refuse(self.tmesh.mesh, label, [(f"{label}: the material axis is normal to {{n}} cell(s), the first at "
+                                         "{at}: give an axis that lies in the shell", cells[bad])], ValueError)
         return np.arctan2(a2, a1)
 
     def _section_rows(self, head: np.ndarray, section, axis, slots: tuple, bending: bool):

@@ -328,6 +328,13 @@ class Scene:
           axes, e2 and e3 turning with its nodes' rotations); its load stiffness enters the
           tangent (:mod:`dolfinx_corot.loads`).
 
+        Shells and membranes: ``per_length``, a uniform dead load per unit reference length in
+        global axes (fx, fy, fz) on edges: the lines of ``where`` if it is a group of lines of the
+        mesh (a gmsh physical curve), or the part's boundary edges between the nodes of ``where``
+        if it is a group of nodes. Its nodal forces are q l/2 per edge end, and on OPT triangles
+        the drilling moments of their quadratic edge field (:mod:`dolfinx_corot.elements.uniform_load`),
+        without which nodal forces at a free corner of OPT triangles are not a constant-stress load.
+
         Returns the load as a :class:`~dolfinx_corot.conditions.Condition` (construction stages
         may add it — applied over that stage — or remove it — taken off over that stage).
         """

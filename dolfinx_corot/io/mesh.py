@@ -115,6 +115,10 @@ class TaggedMesh:
             raise GroupNotFoundError(f"physical group '{name}' not found in the mesh; it has: {known}")
         return self.groups[name]
 
+    def group_dim(self, name: str) -> int:
+        """The dimension of group ``name`` (refused with the groups there are if it is not one)."""
+        return self._check(name)[0]
+
     def cells(self, name: str | None) -> np.ndarray:
         """Local cells (owned and ghost) of the cell group ``name``; all cells for None."""
         tdim = self.tdim

@@ -715,7 +715,7 @@ class Part:
                           "(from_gmsh(model, gdim=3))")
 
     def add_line_load(self, part: PartRef, where, q, axes, follower, amplitude=None, condition=None) -> Condition:
-        self._refuse_kind("load per length on", where, "it acts on beams and bars")
+        self._refuse_kind("load per length on", where, "it acts on beams, bars and the edges of shells and membranes")
 
     def add_pressure(self, part: PartRef, where, p, follower, amplitude=None, condition=None) -> Condition:
         self._refuse_kind("pressure on", where, "it acts on shells, membranes and the faces of solids")

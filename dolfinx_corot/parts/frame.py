@@ -197,9 +197,6 @@ class LineFrame(Part):
                       amplitude=None, condition: Condition | None = None) -> Condition:
         """A uniform load per unit length on the beams or bars of ``part`` (see ``Scene.load``)."""
         label = self._label(part)
-        if self.tdim != 1:
-            raise ValueError(f"load per length on {label}: it acts on beams and bars; on shells and membranes "
-                             "give a pressure (scene.pressure) or a weight (scene.gravity)")
         cells = self._loaded_cells(part, where, "load per length")
         condition = condition or Condition("load", f"per length on {label}")
         if follower:

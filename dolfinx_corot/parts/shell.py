@@ -21,6 +21,7 @@ from .. import _dolfinx
 from ..elements import membrane_quad as quad_law
 from ..elements import shell_quad as quad_shell_law
 from ..elements import shell_triangle as shell_law
+from ..elements import uniform_load
 from ..conditions import Condition
 from ..io.mesh import TaggedMesh
 from ..kernels import CCW, RESULTANTS, OnFirstUse
@@ -30,6 +31,17 @@ from .base import PartRef
 from .cells import mesh_extent, quadrilateral_problems, refuse, triangle_problems
 from .frame import Frame3D, LineFrame, Rotations3D
 from .surface import Surface, SurfaceError, gather_surface
+
+
+def _cell_normals(X: np.ndarray) -> np.ndarray:
+    """(n, 3) unit normals of cells X (n, 3 or 4, 3) by the right-hand rule over their nodes;
+    quadrilaterals (DOLFINx's order (0, 0), (1, 0), (0, 1), (1, 1)): at the centre of the
+    bilinear patch."""
+    if X.shape[1] == 3:
+        n = np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
+    else:
+        n = np.cross(X[:, 1] + X[:, 3] - X[:, 0] - X[:, 2], X[:, 2] + X[:, 3] - X[:, 0] - X[:, 1])
+    return n / np.linalg.norm(n, axis=1)[:, None]
 
 
 class Surface3D(Rotations3D, LineFrame):
@@ -46,6 +58,8 @@ class Surface3D(Rotations3D, LineFrame):
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
         LineFrame.__init__(self, tmesh, large_rotations)
         self._init_state()
+        # dead loads per length on edges: ((cells, ends), q, amplitude, condition)
+        self._edge_loads: list = []
 
     def _kernel_constants(self) -> list:
         """The kernels' per-cell constants of every cell with elements (DG0, computed once per
@@ -95,13 +109,98 @@ class Surface3D(Rotations3D, LineFrame):
             return condition
 
         def along_initial_normals(cells, X, p=p):
-            if kind == "triangle":
-                n = np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0])
-            else:  # the normal at the centre of the bilinear patch (nodes (0,0), (1,0), (0,1), (1,1))
-                n = np.cross(X[:, 1] + X[:, 3] - X[:, 0] - X[:, 2], X[:, 2] + X[:, 3] - X[:, 0] - X[:, 1])
-            return p * n / np.linalg.norm(n, axis=1)[:, None]
+            return p * _cell_normals(X)
         self._distributed.append((label, where, along_initial_normals, amplitude, condition))
         return condition
+
+    # -- loads on edges ------------------------------------------------------------
+    def add_line_load(self, part: PartRef, where: str | None, q: np.ndarray, axes: str, follower: bool,
+                      amplitude=None, condition: Condition | None = None) -> Condition:
+        """A uniform dead load q per unit reference length, in global axes, on edges of the shells or
+        membranes of ``part`` (see ``Scene.load``): the lines of a group of lines of the mesh, or
+        the part's boundary edges between nodes of a group of nodes."""
+        label = self._label(part)
+        if where is None:
+            raise ValueError(f"load per length on {label}: name the edges it acts on (a group of lines of the "
+                             "mesh, or a group of nodes: the part's boundary edges between them)")
+        if axes != "global" or follower:
+            raise ValueError(f"load per length on the edges '{where}' of {label}: on shells and membranes it is "
+                             "a dead load in global axes (axes='global', follower=False); a pressure that turns "
+                             "with the surface is scene.pressure")
+        edges = self._loaded_edges(label, where)
+        if not self.comm.allreduce(len(edges[0])):
+            dim = self.tmesh.groups[where][0]
+            what = "lines" if dim == 1 else "boundary edges between its nodes"
+            raise ValueError(f"load per length on {label}: group '{where}' has no {what} on its cells")
+        condition = condition or Condition("load", f"per length on the edges '{where}' of {label}")
+        self._edge_loads.append((edges, q, amplitude, condition))
+        return condition
+
+    def _loaded_edges(self, label: str, where: str) -> tuple[np.ndarray, np.ndarray]:
+        """(cells (m,), ends (m, 2)) of the owned edges of group ``where`` on cells of ``label``: a
+        group of lines gives its lines, a group of nodes the edges of one cell of ``label`` with
+        both ends in it; ends: the positions of the edge's nodes in its cell, counter-clockwise."""
+        dim = self.tmesh.group_dim(where)
+        if dim == 2:
+            raise ValueError(f"load per length on {label}: '{where}' is a group of cells; give a group of "
+                             "lines or of nodes along the loaded edges")
+        topology = self.tmesh.mesh.topology
+        for a, b in ((1, 0), (1, 2), (2, 0)):
+            topology.create_connectivity(a, b)
+        f2v, f2c = topology.connectivity(1, 0), topology.connectivity(1, 2)
+        c2v = topology.connectivity(2, 0)
+        n_owned = topology.index_map(1).size_local
+        mine = self._owner_of_cell == label
+        facets = self.tmesh.facets(where) if dim == 1 else None
+        if facets is None:  # a group of nodes: the edges with both ends in it
+            ends = f2v.array.reshape(-1, 2)[:n_owned]
+            facets = np.flatnonzero(np.isin(ends, self.tmesh.vertices(where)).all(axis=1))
+        cyclic = CCW if self.nodes_per_cell == 4 else np.arange(3)
+        cells, positions = [], []
+        for e in facets[facets < n_owned]:
+            on = [c for c in f2c.links(e) if mine[c]]
+            if not on or (dim != 1 and len(on) != 1):
+                continue
+            around = list(c2v.links(on[0])[cyclic])
+            i, j = (around.index(v) for v in f2v.links(e))
+            if (j - i) % self.nodes_per_cell != 1:
+                i, j = j, i
+            cells.append(on[0])
+            positions.append((cyclic[i], cyclic[j]))
+        return np.array(cells, dtype=np.int32), np.array(positions, dtype=np.int64).reshape(-1, 2)
+
+    def _edge_drilling(self, cells: np.ndarray) -> np.ndarray:
+        """α_b of the drilling part of each cell's edge displacement (its edge loads' drilling
+        moments, :func:`~dolfinx_corot.elements.uniform_load.edge_loads`): 0, linear edges."""
+        return np.zeros(len(cells))
+
+    def load_conditions(self) -> list:
+        return super().load_conditions() + [(amp, cond) for *_, amp, cond in self._edge_loads]
+
+    def _add_distributed_loads(self, b, amplitude) -> None:
+        super()._add_distributed_loads(b, amplitude)
+        terms = [(edges, q) for edges, q, amp, cond in self._edge_loads if amp is amplitude and cond.exists]
+        if not terms:
+            return
+        loads = dolfinx.fem.Function(self.V)
+        arr = loads.x.array.reshape(-1, self.ndof)
+        cell_blocks = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)
+        for (cells, ends), q in terms:
+            if self._existing is not None:
+                keep = self._existing[cells]
+                cells, ends = cells[keep], ends[keep]
+            rows = np.arange(len(cells))[:, None]
+            Xc = self.reference[cell_blocks[cells]] + self._activation_translations(cells)
+            normal = _cell_normals(Xc)
+            drilling = self._edge_drilling(cells)
+            forces, moments = uniform_load.edge_loads(Xc[rows, ends], normal, q, drilling)
+            blocks = cell_blocks[cells][rows, ends]
+            np.add.at(arr[:, :3], blocks, forces)
+            np.add.at(arr[:, 3:6], blocks, moments)
+        loads.x.scatter_reverse(dolfinx.la.ScatterMode.add)
+        n = self.V.dofmap.index_map.size_local * self.ndof
+        with b.localForm() as bl:
+            bl.array[:n] += loads.x.array[:n]
 
     section_components = RESULTANTS
 
@@ -257,6 +356,12 @@ class Shell3D(Surface3D):
         head[:6] = E, nu, section.thickness, drilling, 1.0, 1.0 if membrane == "opt" else 0.0
         rows = self._section_rows(head, section, axis, (shell_law.A0, shell_law.B0, shell_law.D0), True)
         return self.add_elements(where, rows, True, "shell", self._fingerprint(head, section, axis))
+
+    def _edge_drilling(self, cells: np.ndarray) -> np.ndarray:
+        """α_b on OPT shells (the drilling part of their edges' displacement, Allman's), 0 on CST
+        shells and membranes (linear edges)."""
+        props = self.cell_properties(cells)
+        return shell_law.ALPHA_B * (self._bending[cells] & (props[:, 5] != 0.0))
 
 
 class ShellQuad(Surface3D):

@@ -128,6 +128,54 @@ def test_load_control_past_a_limit_point_stops_instead_of_jumping(hard_case):
                "cuts": err.value.result.totals["cuts"]})
 
 
+def _pressed_cap(n: int):
+    """The hinged cap of ``demos/hinged_sphere.py`` (sphere R = 100 over the square [−15, 15]², rise
+    2.26, t = 0.25, E = 10⁶, ν = 0.3; one quarter, n × n four-node shells) under a dead uniform
+    pressure of 12 at λ = 1, pressing down."""
+    R, a = 100.0, 15.0
+    g = np.linspace(0.0, a, n + 1)
+    pts = np.array([(x, y, np.sqrt(R**2 - x * x - y * y) - np.sqrt(R**2 - 2 * a * a)) for y in g for x in g])
+    idx = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    cells = np.c_[idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()]
+    groups = {"sym_x": idx[:, 0], "sym_y": idx[0, :], "edges": np.concatenate([idx[:, -1], idx[-1, :]]),
+              "centre": [0]}
+    sc = dc.Scene(large_rotations=True)
+    cap = sc.add_shell(from_arrays(pts, cells, "cap", groups), "cap", thickness=0.25, material=dc.Elastic(1e6, 0.3))
+    sc.fix(cap, "sym_x", dofs=("ux", "ry", "rz"))
+    sc.fix(cap, "sym_y", dofs=("uy", "rx", "rz"))
+    sc.fix(cap, "edges", dofs=("ux", "uy", "uz"))
+    sc.pressure(cap, None, -12.0, follower=False)
+    sc.monitor("centre", cap, "centre")
+    return sc
+
+
+def test_load_control_stops_at_a_limit_point_whose_leap_meets_no_negative_eigenvalue(hard_case):
+    """A hinged spherical cap (12 × 12 quadrilaterals a quarter) under a uniform pressure snaps
+    through at its limit pressure. Load control's step across it used to land on the inverted cap
+    (centre −0.13 → −2.60) with every Newton iterate's tangent positive definite, so the count
+    saw nothing and the run reported completion. The step went some 300 times as far as its
+    tangent predicted; such a step (over 10 times, no contact) is now followed again in parts,
+    and the run stops before the leap at p ≈ 4.59, within 1 % of the limit pressure 4.55 of this
+    cap converged on 24 × 24 cells (4.553 with quadrilaterals, 4.560 with triangles, and 4.616
+    with triangles on 12 × 12)."""
+    with pytest.raises(dc.CriticalPointError, match="limit point") as err:
+        dc.solve(_pressed_cap(12), dc.LoadControl(steps=60))
+    (cp,) = err.value.result.critical_points
+    assert cp.kind == "limit point (jumped)"
+    assert 12.0 * cp.load_factor == pytest.approx(4.55, rel=0.015)
+    kept = err.value.result.history.rows[-1]
+    assert kept["centre_uz"] > -0.1  # nothing of the inverted cap kept
+    hard_case("Load control across a limit point where no iterate meets a negative eigenvalue",
+              "A pressed spherical cap of quadrilateral shells snaps through; Newton's iterates leap from "
+              "the near branch to the inverted cap through states whose tangents are all positive "
+              "definite, so the count alone misses the limit point. A step that goes over ten times as far "
+              "as its tangent predicted must be checked in parts and the run stopped before the leap.",
+              {"limit pressure estimate": 12.0 * cp.load_factor, "converged limit pressure (24 x 24)": 4.55,
+               "bracket of pressures": [12.0 * b for b in cp.bracket], "last centre deflection kept": kept[
+                   "centre_uz"], "Newton iterations": err.value.result.totals["newton_iterations"],
+               "cuts": err.value.result.totals["cuts"]})
+
+
 def test_arc_length_lists_the_limit_point(hard_case):
     """Arc-length follows the truss through its limit point: the count of negative eigenvalues
     changes where λ turns, and the limit point's load (a parabola through the path points around

@@ -35,6 +35,20 @@ STABILITY = ("auto", "on", "off")
 LEAP_CUTS = 4
 # ... when the step's increment exceeds LEAP_RATIO times its first (tangent) correction
 LEAP_RATIO = 2.0
+# a step that goes FAR_LEAP_RATIO times as far as its tangent predicted is checked for a leap even where
+# its iterates showed no less stable state (see :func:`_far_beyond_prediction`)
+FAR_LEAP_RATIO = 10.0
+
+
+def _far_beyond_prediction(system, tracker, report, before, after) -> bool:
+    """Whether a step between stable states went more than FAR_LEAP_RATIO times as far as its
+    tangent predicted, on a system whose factorizations give the determinant's sign alone (LU),
+    which does not change where two eigenvalues cross zero together (a symmetric structure's
+    double mode): a leap across a limit point that the signs miss. Systems with contact are
+    left out: a gap that closes or a stick that slips makes such steps on a stable path."""
+    return (not system.contributions and before == 0 and after == 0
+            and bool(report.increments)
+            and system.step_increment_norm() > FAR_LEAP_RATIO * report.increments[0])
 
 logger = logging.getLogger(__name__)
 
@@ -61,9 +75,10 @@ class LoadControl:
     systems of up to 200 000 dofs — 20 000 for 3D continua on the iterative solver; 'on';
     'off'; see :mod:`~dolfinx_corot.solvers.stability`);
     at_critical_point: where the count changes (a bifurcation) or a step leaps across a limit
-    point (its Newton iterates cross states less stable than both ends, it goes more than twice
-    as far as its tangent predicted, and it still does so when followed again in halves down to
-    1/16 of it; the history columns
+    point (its Newton iterates cross states less stable than both ends and it goes more than twice
+    as far as its tangent predicted — or, without contact, more than ten times as far whatever
+    its iterates' counts, which can skip the unstable states altogether — and it still does so
+    when followed again in halves down to 1/16 of it; the history columns
     ``stability_checks`` and ``stability_iterations`` count such checks and the Newton iterations
     they took), the critical point is recorded (``result.critical_points``, with its load factor) and
     'stop' (default) ends the run at the last state before it with a
@@ -202,6 +217,7 @@ class LoadControl:
                 before, after, passed = tracker.converged(trial, starts_next=not self.extrapolate)
                 # past a critical point (the path already unstable) the iterates' counts say nothing
                 passed = passed and before == 0
+                passed = passed or _far_beyond_prediction(system, tracker, report, before, after)
                 leap = None
                 if passed and after == before and report.increments and \
                         system.step_increment_norm() <= LEAP_RATIO * report.increments[0]:
@@ -307,7 +323,7 @@ class LoadControl:
             flagged = not report.converged
             if report.converged:
                 _, after, passed = tracker.converged(b)
-                flagged = passed or after != before
+                flagged = passed or after != before or _far_beyond_prediction(system, tracker, report, before, after)
             if flagged:
                 system.restore(cp_a)
                 tracker.negative = before
@@ -355,8 +371,10 @@ class LoadControl:
         point = CriticalPoint(kind, float(estimate), (float(lam), float(trial)), run.step + 1, int(before),
                               int(after), how)
         run.critical_points.append(point)
-        change = (f"the Newton iterates crossed states whose tangent has more than {before} negative "
-                  "eigenvalues" if after == before else f"negative eigenvalues of the tangent {before} → {after}")
+        change = (f"the step leapt: its Newton iterates crossed states whose tangent has more than {before} "
+                  f"negative eigenvalues, or it went over {FAR_LEAP_RATIO:g} times as far as its tangent "
+                  f"predicted, also in parts down to 1/{2**LEAP_CUTS} of it" if after == before
+                  else f"negative eigenvalues of the tangent {before} → {after}")
         words = (f"step {run.step + 1}: a {kind} near load factor {estimate:.6g} (between {lam:.6g} and "
                  f"{trial:.6g}; {change})")
         if self.at_critical_point == "stop":

@@ -22,7 +22,7 @@ demos: setup
 	@for d in demos/*.py; do echo "== $$d"; $(PY) $$d || exit 1; done
 
 test: setup
-	$(PY) -m pytest -ra tests
+	$(PY) -m pytest -ra --durations=25 tests
 
 # the site: demo pages from demos/*.py and their outputs (shortened runs, reused while fresh)
 docs: setup-docs

@@ -169,9 +169,10 @@ class ElementResults:
     (the same arrays in serial and under MPI, elements ordered by their input index).
 
     kind: 'section forces' (beams and bars: the two ends of each element), 'shell resultants'
-    (shells and membranes: the centroid) or 'stresses' (solids: the centre of each cell);
+    (shells and membranes: the centroid), 'ply stresses' (laminated shells: the bottom and top
+    of every ply above the centroid) or 'stresses' (solids: the centre of each cell);
     components: the names of the values; cells: (n,) input index of each element; points:
-    (n, p, gdim) current positions where the values hold (p = 2 ends or 1 centre); values:
+    (n, p, gdim) current positions where the values hold (p = 2 ends, 2 per ply, or 1 centre); values:
     (n, p, len(components)); axes: (n, gdim, gdim) the element axes, rows e1, e2 (, e3), in the
     current configuration (None for solids, whose components are global).
 

@@ -620,6 +620,23 @@ class Scene:
         label = f"{part.kind} '{part.name or 'all cells'}'" + (f" within '{where}'" if where else "")
         return model.element_results(cells, label)
 
+    def ply_stresses(self, part: PartRef, where: str | None = None):
+        """Stresses in the plies of the laminate of shells ``part`` (within its cell group
+        ``where``) at the current state, on every rank — a
+        :class:`~dolfinx_corot.result.ElementResults` of kind 'ply stresses': at the centre of each
+        cell, at the bottom and top face of every ply (from the bottom of the laminate up), the
+        stresses s11 (along the ply's fibres), s22 (across them, in the shell) and s12 in the ply's
+        axes, with the height z above the mid-surface and the ply's index (classical lamination
+        theory from the cell's resultants). The cells must share one section. Collective."""
+        model = part.model
+        if not hasattr(model, "ply_stresses"):
+            raise ValueError(f"ply stresses of {part.kind} '{part.name}': they are for shells")
+        cells = model.tmesh.cells(part.name or None)
+        if where is not None:
+            cells = np.intersect1d(cells, model.tmesh.cells(where)).astype(np.int32)
+        label = f"{part.kind} '{part.name or 'all cells'}'" + (f" within '{where}'" if where else "")
+        return model.ply_stresses(cells, label)
+
     def monitor_reaction(self, name: str, part: PartRef, where: str) -> None:
         """Record the force (sum over the nodes of ``where``) that the supports or prescribed
         displacements there exert on the structure, after every step: name_Fx, name_Fy, name_Mz

@@ -8,6 +8,7 @@ from scipy.optimize import brentq
 
 import dolfinx_corot as dc
 from dolfinx_corot.io.mesh import from_arrays
+from dolfinx_corot.parts.base import PartRef
 from dolfinx_corot.sections import turned_stiffness
 
 # graphite–epoxy plies as in Pagano (1970) and Reddy (2004, §5.2): E1/E2 = 25
@@ -199,7 +200,7 @@ def test_the_readme_laminate_example_runs_and_bends_as_a_laminated_strip():
     """The README's laminated cantilever plate (quasi-isotropic carbon lay-up, tip load), run as
     written: its tip deflection lies between those of a strip with the plate stiffness D11 and
     the beam stiffness 1/(D⁻¹)11 per unit width, P L³/(3 b D) (Euler–Bernoulli; the 3 % tip
-    rotation changes it by less than 0.1 %)."""
+    rotation changes it by less than 0.1 %); its largest fibre stress is in an outer 0° ply."""
     import contextlib
     import io
     import re
@@ -217,6 +218,10 @@ def test_the_readme_laminate_example_runs_and_bends_as_a_laminated_strip():
     P, L, b = 10.0, space["L"], space["b"]
     stiff, soft = P * L**3 / (3 * b * D[0, 0]), P * L**3 / (3 * b / np.linalg.inv(D)[0, 0])
     assert stiff < w < soft
+    # bending: the fibre stress is largest in the outer 0° plies, at the root
+    plies = space["plies"]
+    k = np.unravel_index(np.argmax(np.abs(plies["s11"])), plies["s11"].shape)
+    assert plies["ply"][k] in (0, 7) and out.getvalue().splitlines()[1].startswith("largest fibre stress")
 
 
 @pytest.mark.parametrize("kind", ["quad", "triangle", "quad_with_shells"])
@@ -273,3 +278,96 @@ def test_bad_sections_are_named():
         dc.Ply(0.01, 0.0, "steel")
     with pytest.raises(ValueError, match="Orthotropic: nu12 = 6.0 makes the layer unstable"):
         dc.Orthotropic(E1=1.0, E2=1.0, G12=0.5, nu12=6.0)
+
+
+def _stretched_and_bent(kind, lam, N, M, axis=(1.0, 0.0, 0.0)):
+    """A free square plate of ``lam`` (2 × 2 cells) held against rigid motion, under edge loads N
+    (x = 0 and 1) and end moments M per length about y on the same edges (their nodal shares):
+    a uniform state of resultants (Nxx, Mxx) = (N, M) in every cell (geometrically linear)."""
+    tm = _plate(1.0, 1.0, 2, 2, kind)
+    sc = dc.Scene(large_rotations=False)
+    p = sc.add_shell(tm, "plate", section=lam, axis=axis, membrane="cst" if kind == "triangle" else None)
+    sc.fix(p, "corner", dofs=("ux", "uy", "uz"))
+    sc.fix(p, "x1", dofs=("uy", "uz"))
+    sc.fix(p, "y1", dofs=("uz",))
+    for x_edge, sign in ((1.0, 1.0), (0.0, -1.0)):
+        for j, y in enumerate((0.0, 0.5, 1.0)):
+            tm.add_point_group(f"e{int(x_edge)}_{j}", [[x_edge, y, 0.0]])
+            share = 0.25 if j != 1 else 0.5
+            sc.load(p, f"e{int(x_edge)}_{j}", force=(sign * N * share, 0.0, 0.0), moment=(0.0, sign * M * share, 0.0))
+    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
+    return sc, p
+
+
+@pytest.mark.parametrize("kind", ["quad", "triangle"])
+@pytest.mark.parametrize("angles", [(0, 90, 90, 0), (45, -45, -45, 45), (0, 90)])
+def test_ply_stresses_follow_lamination_theory(kind, angles):
+    """Stresses in the plies of a laminate under a membrane force Nxx = 1 and a moment Mxx = 10⁻³
+    per length (a free plate, every cell in the same state): in each ply's axes, at the bottom
+    and top of each ply, those of classical lamination theory (Jones 1999, §4.2–4.3): (ε, κ) =
+    [A B; B D]⁻¹(N, M), σ_xy = Q̄ₖ(ε + zκ), σ₁₂ = T(θₖ)σ_xy — for the symmetric cross-ply
+    [0/90]s, the angle-ply [45/−45]s (shear in the plies' axes) and the unsymmetric [0/90] (B ≠ 0),
+    to 1e-8 of the largest; through the thickness they add up to N and M (1e-10)."""
+    t, N, M = 0.01, 1.0, 1e-3
+    lam = cross_ply(t, angles)
+    sc, p = _stretched_and_bent(kind, lam, N, M)
+    r = sc.ply_stresses(p)
+    assert r.values.shape == (len(r.cells), 2 * len(angles), 5)
+    A, B, D, _ = (m[0] for m in lam.matrices(0.0))
+    eps_kap = np.linalg.solve(np.block([[A, B], [B, D]]), [N, 0, 0, M, 0, 0])
+    z = -t / 2 + np.arange(len(angles) + 1) * t / len(angles)
+    for k, angle in enumerate(angles):
+        th = np.radians(angle)
+        c, s = np.cos(th), np.sin(th)
+        T = np.array([[c * c, s * s, 2 * c * s], [s * s, c * c, -2 * c * s], [-c * s, c * s, c * c - s * s]])
+        Qbar = turned_stiffness(lam.plies[k].stiffness()[0], np.array([th]))[0]
+        for side, height in enumerate((z[k], z[k + 1])):
+            expected = T @ Qbar @ (eps_kap[:3] + height * eps_kap[3:])
+            got = r.values[:, 2 * k + side, :3]
+            np.testing.assert_allclose(got, np.broadcast_to(expected, got.shape), atol=1e-8 * 1e3 * N / t)
+            np.testing.assert_allclose(r.values[:, 2 * k + side, 3:], [[height, k]] * len(r.cells), atol=1e-15)
+    # through the thickness (linear in z in each ply): σx integrates to N, σx·z to M
+    sx = []
+    for k, angle in enumerate(angles):
+        th = np.radians(angle)
+        c, s = np.cos(th), np.sin(th)
+        s11, s22, s12 = (r.values[0, 2 * k:2 * k + 2, j] for j in range(3))
+        sx.append(c * c * s11 + s * s * s22 - 2 * c * s * s12)  # back to x
+    h = t / len(angles)
+    Nx = sum(0.5 * h * (a + b) for a, b in sx)
+    Mx = sum(h / 6 * (a * (2 * z[k] + z[k + 1]) + b * (z[k] + 2 * z[k + 1])) for k, (a, b) in enumerate(sx))
+    assert Nx == pytest.approx(N, rel=1e-10) and Mx == pytest.approx(M, rel=1e-8)
+
+
+def test_ply_stresses_of_one_isotropic_layer_are_the_face_stresses():
+    """One isotropic layer: its ply stresses at the faces are the element results' face stresses
+    σ = N/t ± 6M/t² (1e-10)."""
+    t = 0.01
+    lam = dc.Laminate.single(t, dc.Elastic(2e5, 0.3))
+    sc, p = _stretched_and_bent("quad", lam, 1.0, 1e-3, axis=None)
+    plies, faces = sc.ply_stresses(p), sc.element_results(p)
+    np.testing.assert_allclose(plies["s11"][:, 0], faces["sxx_bottom"][:, 0], rtol=1e-10)
+    np.testing.assert_allclose(plies["s11"][:, 1], faces["sxx_top"][:, 0], rtol=1e-10)
+    np.testing.assert_allclose(plies["s22"][:, 1], faces["syy_top"][:, 0], atol=1e-10 * abs(faces["sxx_top"]).max())
+
+
+def test_ply_stresses_are_refused_for_membranes_and_mixed_sections():
+    """Membranes have no plies to report (N/t), and cells of two sections need a group each."""
+    tm = _plate(1.0, 1.0, 2, 2, "triangle")
+    tm.add_cell_group("left", lambda x: x[0] < 0.5)
+    tm.add_cell_group("right", lambda x: x[0] > 0.5)
+    sc = dc.Scene(large_rotations=False)
+    thin, thick = cross_ply(0.01, (0, 90, 90, 0)), cross_ply(0.02, (0, 90, 90, 0))
+    left = sc.add_shell(tm, "left", section=thin, axis=(1.0, 0.0, 0.0))
+    sc.add_shell(tm, "right", section=thick, axis=(1.0, 0.0, 0.0))
+    sc.fix(left, "edge")
+    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
+    assert sc.ply_stresses(left).values.shape[1] == 8
+    both = PartRef(left.model, "plate", "shell")  # the cells of both sections
+    with pytest.raises(ValueError, match="different sections"):
+        sc.ply_stresses(both)
+    tm2 = _plate(1.0, 1.0, 2, 2, "quad")
+    sc2 = dc.Scene(large_rotations=False)
+    m = sc2.add_membrane(tm2, "plate", thickness=0.01, material=dc.Elastic(1e6, 0.3))
+    with pytest.raises(ValueError, match="give shells"):
+        sc2.ply_stresses(m)

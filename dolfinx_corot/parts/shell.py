@@ -27,10 +27,21 @@ from ..io.mesh import TaggedMesh
 from ..kernels import CCW, RESULTANTS, OnFirstUse
 from ..loads import FollowerLoad
 from ..result import ElementResults
+from ..sections import turned_stiffness
 from .base import PartRef
 from .cells import mesh_extent, quadrilateral_problems, refuse, triangle_problems
 from .frame import Frame3D, LineFrame, Rotations3D
 from .surface import Surface, SurfaceError, gather_surface
+
+
+def _same_section(a: tuple, b: tuple) -> bool:
+    """Whether two (section, material axis) pairs are the same."""
+    (sa, xa), (sb, xb) = a, b
+    if sa != sb or (xa is None) != (xb is None):
+        return False
+    if callable(xa) or callable(xb):
+        return xa is xb
+    return xa is None or bool(np.array_equal(np.asarray(xa, dtype=float), np.asarray(xb, dtype=float)))
 
 
 def _cell_normals(X: np.ndarray) -> np.ndarray:
@@ -60,6 +71,7 @@ class Surface3D(Rotations3D, LineFrame):
         self._init_state()
         # dead loads per length on edges: ((cells, ends), q, amplitude, condition)
         self._edge_loads: list = []
+        self._sections: dict = {}  # shells' label → (section, material axis)
 
     def _kernel_constants(self) -> list:
         """The kernels' per-cell constants of every cell with elements (DG0, computed once per
@@ -224,6 +236,60 @@ class Surface3D(Rotations3D, LineFrame):
         return self._gather_results("shell resultants", self.section_components, cells, centre, values[:, None, :],
                                     axes, label, gather)
 
+    PLY_COMPONENTS = ("s11", "s22", "s12", "z", "ply")
+    section_slots: tuple | None = None  # where a shell's A, B, D sit in its cells' properties
+
+    def _remember_section(self, ref: PartRef, section, axis) -> PartRef:
+        """Keep the section and material axis of the shells ``ref`` (for their ply stresses)."""
+        self._sections[self._label(ref)] = (section, axis)
+        return ref
+
+    def ply_stresses(self, cells: np.ndarray | None = None, label: str = "") -> ElementResults:
+        """Stresses in the plies of the shells' laminate at the centre of each cell, in each ply's
+        own axes (1 along its fibres, 2 across, in the shell), at the bottom and the top face of
+        every ply from the bottom of the laminate up (2 points per ply): classical lamination
+        theory (Jones 1999, §4.2): the mid-surface strains and curvatures (ε, κ) =
+        [A B; B D]⁻¹(N, M) of the cell's resultants (:meth:`element_results`), σ = Q̄ₖ(ε + zκ) in
+        the element frame, turned to the ply's axes. Components s11, s22, s12, the height z
+        above the mid-surface (along e3) and the ply's index; points at the centre moved by z e3.
+        The cells must share one section."""
+        cells = self._result_cells(cells)
+        owners = sorted(set().union(*self.comm.allgather(set(self._owner_of_cell[cells]))))
+        known = [o for o in owners if o in self._sections]
+        if len(known) != len(owners) or not owners:
+            raise ValueError(f"ply stresses of {label or 'the part'}: give shells (membranes carry N/t alone)")
+        if any(not _same_section(self._sections[o], self._sections[owners[0]]) for o in owners):
+            raise ValueError(f"ply stresses of {label or 'the part'}: its cells have different sections "
+                             f"({', '.join(owners)}); ask for the cells of one of them")
+        section, axis = self._sections[owners[0]]
+        res = self.element_results(cells, label, gather=False)
+        NM = res.values[:, 0, :6]
+        props = self.cell_properties(cells)
+        a0, b0, d0 = self.section_slots
+        A, B, D = (props[:, k:k + 9].reshape(-1, 3, 3) for k in (a0, b0, d0))
+        ABD = np.concatenate([np.concatenate([A, B], axis=2), np.concatenate([B, D], axis=2)], axis=1)
+        strains = np.linalg.solve(ABD, NM[:, :, None])[:, :, 0] if len(cells) else np.zeros((0, 6))
+        eps, kappa = strains[:, :3], strains[:, 3:]
+        phi = np.zeros(len(cells)) if section.isotropic else self._material_angles(cells, axis, label)
+        e3 = res.axes[:, 2] if len(cells) else np.zeros((0, 3))
+        values, points = [], []
+        z = -0.5 * section.thickness
+        for k, ply in enumerate(section.plies):
+            Q, _ = ply.stiffness()
+            theta = phi + np.radians(ply.angle)
+            Qbar = turned_stiffness(Q, theta)
+            c, s = np.cos(theta), np.sin(theta)
+            for height in (z, z + ply.thickness):
+                sx, sy, sxy = np.einsum("nij,nj->in", Qbar, eps + height * kappa)
+                values.append(np.stack([c * c * sx + s * s * sy + 2 * c * s * sxy,
+                                        s * s * sx + c * c * sy - 2 * c * s * sxy,
+                                        c * s * (sy - sx) + (c * c - s * s) * sxy,
+                                        np.full(len(cells), height), np.full(len(cells), float(k))], axis=1))
+                points.append(res.points[:, 0] + height * e3)
+            z += ply.thickness
+        return self._gather_results("ply stresses", self.PLY_COMPONENTS, cells, np.stack(points, axis=1),
+                                    np.stack(values, axis=1), res.axes, label)
+
     def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray:
         """The thickness."""
         return self.cell_properties(cells)[:, 2]
@@ -332,6 +398,7 @@ class Shell3D(Surface3D):
     nodes_per_cell = 3
     nprops = shell_law.NPROPS
     membrane_A0 = shell_law.A0
+    section_slots = (shell_law.A0, shell_law.B0, shell_law.D0)
     kernels = OnFirstUse("shell3d")
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
@@ -355,7 +422,8 @@ class Shell3D(Surface3D):
         head = np.zeros(shell_law.NPROPS)
         head[:6] = E, nu, section.thickness, drilling, 1.0, 1.0 if membrane == "opt" else 0.0
         rows = self._section_rows(head, section, axis, (shell_law.A0, shell_law.B0, shell_law.D0), True)
-        return self.add_elements(where, rows, True, "shell", self._fingerprint(head, section, axis))
+        return self._remember_section(self.add_elements(where, rows, True, "shell",
+                                                        self._fingerprint(head, section, axis)), section, axis)
 
     def _edge_drilling(self, cells: np.ndarray) -> np.ndarray:
         """α_b on OPT shells (the drilling part of their edges' displacement, Allman's), 0 on CST
@@ -373,6 +441,7 @@ class ShellQuad(Surface3D):
 
     nodes_per_cell = 4
     nprops = quad_shell_law.NPROPS
+    section_slots = (quad_shell_law.A0, quad_shell_law.B0, quad_shell_law.D0)
     membrane_A0 = quad_shell_law.A0
     kernels = OnFirstUse("shell_quad")
 
@@ -392,7 +461,8 @@ class ShellQuad(Surface3D):
         head[quad_shell_law.KIRCHHOFF] = 1.0 if kinematics == "kirchhoff" else 0.0
         slots = (quad_shell_law.A0, quad_shell_law.B0, quad_shell_law.D0, quad_shell_law.S0)
         rows = self._section_rows(head, section, axis, slots, True)
-        return self.add_elements(where, rows, True, "shell", self._fingerprint(head, section, axis))
+        return self._remember_section(self.add_elements(where, rows, True, "shell",
+                                                        self._fingerprint(head, section, axis)), section, axis)
 
 
 class MembraneQuad(Surface3D):

@@ -35,7 +35,8 @@ import numpy as np
 
 from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
 from .frame_triangle import _dTiT_m
-from .transform import frame_axes, linear_force, local_coordinates, positions, rotate_columns, stiffness
+from .transform import (add_omega_w, frame_axes, linear_force, local_coordinates, positions, rotate_columns,
+                        stiffness, subtract_spin_g_omega, to_global)
 
 H = 1e-30  # complex step of the frame spin's variation
 
@@ -289,13 +290,7 @@ def shell_force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K):
     linear_force(Bl, Kbar, dbar, fbar, g, 24, 24)
     Kl = np.empty((24, 24))
     stiffness(Bl, Kbar, Kl, 24, 24)
-    for b in range(8):
-        g0, g1, g2 = g[3 * b], g[3 * b + 1], g[3 * b + 2]
-        for col in range(24):
-            o0, o1, o2 = Om[0, col], Om[1, col], Om[2, col]
-            Kl[3 * b + 0, col] -= g1 * o2 - g2 * o1
-            Kl[3 * b + 1, col] -= g2 * o0 - g0 * o2
-            Kl[3 * b + 2, col] -= g0 * o1 - g1 * o0
+    subtract_spin_g_omega(Kl, g, Om, 24)
     v = np.zeros(3)
     M = np.zeros((4, 3, 3))
     for a in range(4):
@@ -327,31 +322,5 @@ def shell_force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K):
                 for k in range(3):
                     acc += J[i, 3 * a + k] * Bl[6 * a + k, j]
             Kl[i, j] += acc
-    W = np.zeros((3, 24))
-    for a in range(4):
-        n0, n1, n2 = fbar[6 * a], fbar[6 * a + 1], fbar[6 * a + 2]
-        for j in range(24):
-            t0, t1, t2 = Bl[6 * a, j], Bl[6 * a + 1, j], Bl[6 * a + 2, j]
-            W[0, j] += n1 * t2 - n2 * t1
-            W[1, j] += n2 * t0 - n0 * t2
-            W[2, j] += n0 * t1 - n1 * t0
-            r0, r1, r2 = Bl[6 * a + 3, j], Bl[6 * a + 4, j], Bl[6 * a + 5, j]
-            for i in range(3):
-                MB = M[a, i, 0] * r0 + M[a, i, 1] * r1 + M[a, i, 2] * r2
-                W[i, j] -= MB
-                Kl[6 * a + 3 + i, j] += MB
-    for i in range(24):
-        o0, o1, o2 = Om[0, i], Om[1, i], Om[2, i]
-        if o0 != 0.0 or o1 != 0.0 or o2 != 0.0:
-            for j in range(24):
-                Kl[i, j] += o0 * W[0, j] + o1 * W[1, j] + o2 * W[2, j]
-    for b in range(8):
-        for k in range(3):
-            f[3 * b + k] = Rr[k, 0] * g[3 * b] + Rr[k, 1] * g[3 * b + 1] + Rr[k, 2] * g[3 * b + 2]
-    tmp = np.empty((24, 24))
-    rotate_columns(Kl, Rr, tmp, 24, 24)
-    for br in range(8):
-        for k in range(3):
-            for j in range(24):
-                K[3 * br + k, j] = (Rr[k, 0] * tmp[3 * br, j] + Rr[k, 1] * tmp[3 * br + 1, j]
-                                    + Rr[k, 2] * tmp[3 * br + 2, j])
+    add_omega_w(Kl, fbar, Bl, M, Om, 4, True)
+    to_global(Kl, g, Rr, f, K, 24)

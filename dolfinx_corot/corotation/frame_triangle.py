@@ -38,7 +38,8 @@ import numba
 import numpy as np
 
 from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
-from .transform import frame_axes, linear_force, local_coordinates, positions, rotate_columns, stiffness
+from .transform import (add_omega_w, frame_axes, linear_force, local_coordinates, positions, rotate_columns,
+                        stiffness, subtract_spin_g_omega, to_global)
 
 
 @numba.njit(cache=True)
@@ -225,14 +226,7 @@ def force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K, rotations=True):
     linear_force(Bl, Kbar, dbar, fbar, g, 18, 18)
     Kl = np.empty((18, 18))
     stiffness(Bl, Kbar, Kl, 18, 18)  # material part
-    # − S(g) Ω: block b rows 3b..3b+2 get −spin(g_b) Ω
-    for b in range(6):
-        g0, g1, g2 = g[3 * b], g[3 * b + 1], g[3 * b + 2]
-        for col in range(18):
-            o0, o1, o2 = Om[0, col], Om[1, col], Om[2, col]
-            Kl[3 * b + 0, col] -= g1 * o2 - g2 * o1
-            Kl[3 * b + 1, col] -= g2 * o0 - g0 * o2
-            Kl[3 * b + 2, col] -= g0 * o1 - g1 * o0
+    subtract_spin_g_omega(Kl, g, Om, 18)
     # v and M_a
     v = np.zeros(3)
     M = np.zeros((3, 3, 3))
@@ -277,34 +271,6 @@ def force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K, rotations=True):
         if dc_l[i] != 0.0 or dc_b1[i] != 0.0 or dc_b2[i] != 0.0:
             for j in range(18):
                 Kl[i, j] += dc_l[i] * dl[j] + dc_b1[i] * db1[j] + dc_b2[i] * db2[j]
-    # Ωᵀ δv with δv = Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) δd^l
-    W = np.zeros((3, 18))
-    for a in range(3):
-        n0, n1, n2 = fbar[6 * a], fbar[6 * a + 1], fbar[6 * a + 2]
-        for j in range(18):
-            t0, t1, t2 = Bl[6 * a, j], Bl[6 * a + 1, j], Bl[6 * a + 2, j]
-            W[0, j] += n1 * t2 - n2 * t1
-            W[1, j] += n2 * t0 - n0 * t2
-            W[2, j] += n0 * t1 - n1 * t0
-            if rotations:
-                r0, r1, r2 = Bl[6 * a + 3, j], Bl[6 * a + 4, j], Bl[6 * a + 5, j]
-                for i in range(3):
-                    MB = M[a, i, 0] * r0 + M[a, i, 1] * r1 + M[a, i, 2] * r2
-                    W[i, j] -= MB
-                    Kl[6 * a + 3 + i, j] += MB
-    for i in range(18):
-        o0, o1, o2 = Om[0, i], Om[1, i], Om[2, i]
-        if o0 != 0.0 or o1 != 0.0 or o2 != 0.0:
-            for j in range(18):
-                Kl[i, j] += o0 * W[0, j] + o1 * W[1, j] + o2 * W[2, j]
-    # back to global components: f = Λᵀ g, K = Λᵀ K^l Λ (3 × 3 blocks)
-    for b in range(6):
-        for k in range(3):
-            f[3 * b + k] = Rr[k, 0] * g[3 * b] + Rr[k, 1] * g[3 * b + 1] + Rr[k, 2] * g[3 * b + 2]
-    tmp = np.empty((18, 18))
-    rotate_columns(Kl, Rr, tmp, 18, 18)  # K^l Λ
-    for br in range(6):
-        for k in range(3):
-            for j in range(18):
-                K[3 * br + k, j] = (Rr[k, 0] * tmp[3 * br, j] + Rr[k, 1] * tmp[3 * br + 1, j]
-                                    + Rr[k, 2] * tmp[3 * br + 2, j])
+    # Ωᵀ δv with δv = Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) δd^l, and back to global components
+    add_omega_w(Kl, fbar, Bl, M, Om, 3, rotations)
+    to_global(Kl, g, Rr, f, K, 18)

@@ -120,3 +120,63 @@ def local_coordinates(R, x, xbar):
     for a in range(n):
         for k in range(3):
             xbar[a, k] = R[0, k] * (x[a, 0] - c[0]) + R[1, k] * (x[a, 1] - c[1]) + R[2, k] * (x[a, 2] - c[2])
+
+
+# -- the consistent tangent of a shell frame (triangles and quadrilaterals alike) ------------------
+# With the local forces f̄ = K̄ d̄, g = B_lᵀ f̄, the frame spin ω = Ω d^l and v = Σ_a(n_a × x̄_a −
+# T_a⁻ᵀ m_a) (:mod:`.frame_triangle`), the tangent in local components is
+# K^l = B_lᵀ K̄ B_l − S(g) Ω + ∂(Ωᵀ v)/∂d^l + Ωᵀ Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) + Σ_a E_aᵀ M_a B_{θ,a};
+# only ∂(Ωᵀ v)/∂d^l depends on the element's shape. These are the other terms, for ``nodes``
+# nodes of 6 dofs (``rotations`` False: translations alone, the membranes' three-node frame).
+
+@numba.njit(cache=True, inline="always")
+def subtract_spin_g_omega(Kl, g, Om, n):
+    """K^l (n, n) −= S(g) Ω: block b's rows 3b..3b+2 get −spin(g_b) Ω (g (n,), Ω (3, n))."""
+    for b in range(n // 3):
+        g0, g1, g2 = g[3 * b], g[3 * b + 1], g[3 * b + 2]
+        for col in range(n):
+            o0, o1, o2 = Om[0, col], Om[1, col], Om[2, col]
+            Kl[3 * b + 0, col] -= g1 * o2 - g2 * o1
+            Kl[3 * b + 1, col] -= g2 * o0 - g0 * o2
+            Kl[3 * b + 2, col] -= g0 * o1 - g1 * o0
+
+
+@numba.njit(cache=True, inline="always")
+def add_omega_w(Kl, fbar, Bl, M, Om, nodes, rotations):
+    """K^l += Ωᵀ W + Σ_a E_aᵀ M_a B_{θ,a} with W = Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}): n_a, m_a
+    the local nodal forces and moments in f̄ (6 per node), M_a = ∂(T⁻¹(θ̄_a)ᵀ m_a)/∂θ̄_a (nodes, 3, 3)."""
+    n = 6 * nodes
+    W = np.zeros((3, n))
+    for a in range(nodes):
+        n0, n1, n2 = fbar[6 * a], fbar[6 * a + 1], fbar[6 * a + 2]
+        for j in range(n):
+            t0, t1, t2 = Bl[6 * a, j], Bl[6 * a + 1, j], Bl[6 * a + 2, j]
+            W[0, j] += n1 * t2 - n2 * t1
+            W[1, j] += n2 * t0 - n0 * t2
+            W[2, j] += n0 * t1 - n1 * t0
+            if rotations:
+                r0, r1, r2 = Bl[6 * a + 3, j], Bl[6 * a + 4, j], Bl[6 * a + 5, j]
+                for i in range(3):
+                    MB = M[a, i, 0] * r0 + M[a, i, 1] * r1 + M[a, i, 2] * r2
+                    W[i, j] -= MB
+                    Kl[6 * a + 3 + i, j] += MB
+    for i in range(n):
+        o0, o1, o2 = Om[0, i], Om[1, i], Om[2, i]
+        if o0 != 0.0 or o1 != 0.0 or o2 != 0.0:
+            for j in range(n):
+                Kl[i, j] += o0 * W[0, j] + o1 * W[1, j] + o2 * W[2, j]
+
+
+@numba.njit(cache=True, inline="always")
+def to_global(Kl, g, Rr, f, K, n):
+    """f = Λᵀ g and K = Λᵀ K^l Λ (Λ = diag(R_rᵀ, …)) in 3 × 3 blocks; K^l, K (n, n)."""
+    for b in range(n // 3):
+        for k in range(3):
+            f[3 * b + k] = Rr[k, 0] * g[3 * b] + Rr[k, 1] * g[3 * b + 1] + Rr[k, 2] * g[3 * b + 2]
+    tmp = np.empty((n, n))
+    rotate_columns(Kl, Rr, tmp, n, n)  # K^l Λ
+    for br in range(n // 3):
+        for k in range(3):
+            for j in range(n):
+                K[3 * br + k, j] = (Rr[k, 0] * tmp[3 * br, j] + Rr[k, 1] * tmp[3 * br + 1, j]
+                                    + Rr[k, 2] * tmp[3 * br + 2, j])

@@ -125,7 +125,8 @@ def local_coordinates(R, x, xbar):
 # -- the consistent tangent of a shell frame (triangles and quadrilaterals alike) ------------------
 # With the local forces f̄ = K̄ d̄, g = B_lᵀ f̄, the frame spin ω = Ω d^l and v = Σ_a(n_a × x̄_a −
 # T_a⁻ᵀ m_a) (:mod:`.frame_triangle`), the tangent in local components is
-# K^l = B_lᵀ K̄ B_l − S(g) Ω + ∂(Ωᵀ v)/∂d^l + Ωᵀ Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) + Σ_a E_aᵀ M_a B_{θ,a};
+# K^l = B_lᵀ K̄ B_l − S(g) Ω + ∂(Ωᵀ v)/∂d^l + Ωᵀ Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a})
+#       + Σ_a E_aᵀ M_a B_{θ,a};
 # only ∂(Ωᵀ v)/∂d^l depends on the element's shape. These are the other terms, for ``nodes``
 # nodes of 6 dofs (``rotations`` False: translations alone, the membranes' three-node frame).
 

@@ -583,6 +583,13 @@ class System:
         # parts is lifted while the tangent is constrained
         return not self.contributions and not (self.model.coupled and self.has_prescribed_motion)
 
+    @property
+    def smooth(self) -> bool:
+        """Whether the equilibrium path is smooth in the unknowns: no contribution whose active set
+        may change along it (a gap that closes, a stick that slips), so that a stable step that goes
+        far beyond its tangent's prediction has leapt (:mod:`dolfinx_corot.solvers.control`)."""
+        return not self.contributions
+
     def tangent_at(self, load_factor: float, factorize: bool = True) -> None:
         """Assemble (and, with a direct solver, factorize) the tangent at the current configuration,
         its contributions evaluated there; the next Newton solve from here uses it as it is."""

@@ -46,7 +46,7 @@ def _far_beyond_prediction(system, tracker, report, before, after) -> bool:
     which does not change where two eigenvalues cross zero together (a symmetric structure's
     double mode): a leap across a limit point that the signs miss. Systems with contact are
     left out: a gap that closes or a stick that slips makes such steps on a stable path."""
-    return (not system.contributions and before == 0 and after == 0
+    return (system.smooth and before == 0 and after == 0
             and bool(report.increments)
             and system.step_increment_norm() > FAR_LEAP_RATIO * report.increments[0])
 

@@ -113,7 +113,8 @@ def test_unsymmetric_laminate_curls_under_membrane_force(kind):
     and curvature lie in the elements' spaces): 1e-6. Triangles with the CST membrane: nodal
     forces at a free corner are not the OPT's consistent load of a uniform edge traction (which
     carries drilling moments there, from its α_b lumping), so OPT meshes are exact only under
-    displacement or consistent loads (theory.md)."""
+    displacement or consistent loads: a load per length on the edges, ``scene.load(...,
+    per_length=...)`` (theory.md; tests/test_loads.py)."""
     a, t, Nx = 1.0, 0.01, 1.0
     lam = cross_ply(t, (0, 90))
     A, B, D, _ = (m[0] for m in lam.matrices(0.0))

@@ -445,35 +445,11 @@ def test_edge_loads_on_the_lines_of_a_mixed_gmsh_surface(membrane):
     the interface but not where it meets the free edges (4 cells per half: the plate's middle
     line stretches 1.1 % too much, and the quadrilaterals' corners are off by 18 % of the
     stretch)."""
-    import gmsh
+    from gmsh_square import half_recombined_square
 
     t, E, nu = 0.01, 1e6, 0.3
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-        pt = [g.addPoint(x, y, 0) for x, y in ((0, 0), (0.5, 0), (1, 0), (1, 1), (0.5, 1), (0, 1))]
-        lines = [g.addLine(pt[i], pt[(i + 1) % 6]) for i in range(6)]
-        mid = g.addLine(pt[1], pt[4])
-        left = g.addPlaneSurface([g.addCurveLoop([lines[0], mid, lines[4], lines[5]])])
-        right = g.addPlaneSurface([g.addCurveLoop([lines[1], lines[2], lines[3], -mid])])
-        g.synchronize()
-        for c in lines + [mid]:
-            gmsh.model.mesh.setTransfiniteCurve(c, 5)
-        for s in (left, right):
-            gmsh.model.mesh.setTransfiniteSurface(s)
-        gmsh.model.mesh.setRecombine(2, right)
-        for dim, tags, tag, name in ((2, [left, right], 1, "plate"), (1, [lines[5]], 2, "x0"),
-                                     (1, [lines[2]], 3, "x1")):
-            gmsh.model.addPhysicalGroup(dim, tags, tag)
-            gmsh.model.setPhysicalName(dim, tag, name)
-        gmsh.model.mesh.generate(2)
-    model = gmsh.model if comm.rank == 0 else None
-    try:
+    with half_recombined_square(comm, lambda i: 5, [("x0", [5]), ("x1", [2])]) as model:
         tri, quad = (dc.from_gmsh(model, 3, cells=shape) for shape in ("triangle", "quadrilateral"))
-    finally:
-        if comm.rank == 0:
-            gmsh.finalize()
     sc = dc.Scene(large_rotations=False)
     left_part = sc.add_shell(tri, "plate", thickness=t, material=dc.Elastic(E, nu), membrane=membrane)
     right_part = sc.add_shell(quad, "plate", thickness=t, material=dc.Elastic(E, nu))

@@ -327,39 +327,17 @@ def test_mixed_triangle_and_quadrilateral_mesh():
     and all-quadrilateral meshes of the same grid and within 0.6 % of Timoshenko's
     0.00406 qa⁴/D (8 cells a side: −0.51 %; on the 8 × 8 grids of the test above, triangles
     −0.96 %, quadrilaterals −0.06 %)."""
-    import gmsh
     from mpi4py import MPI
+
+    from gmsh_square import half_recombined_square
 
     comm = MPI.COMM_WORLD
     E_, nu, t, q = 1e4, 0.3, 0.01, 1e-3
     w_ref = 0.00406235 * q / (E_ * t**3 / (12 * (1 - nu**2)))
-    if comm.rank == 0:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        g = gmsh.model.geo
-        p = [g.addPoint(x, y, 0) for x, y in ((0, 0), (0.5, 0), (1, 0), (1, 1), (0.5, 1), (0, 1))]
-        lines = [g.addLine(p[i], p[(i + 1) % 6]) for i in range(6)]
-        mid = g.addLine(p[1], p[4])
-        left = g.addPlaneSurface([g.addCurveLoop([lines[0], mid, lines[4], lines[5]])])
-        right = g.addPlaneSurface([g.addCurveLoop([lines[1], lines[2], lines[3], -mid])])
-        g.synchronize()
-        for c in lines + [mid]:
-            gmsh.model.mesh.setTransfiniteCurve(c, 9 if c in (lines[2], lines[5], mid) else 5)
-        for s in (left, right):
-            gmsh.model.mesh.setTransfiniteSurface(s)
-        gmsh.model.mesh.setRecombine(2, right)
-        for dim, tags, tag, name in ((2, [left, right], 1, "plate"), (1, lines, 2, "edge")):
-            gmsh.model.addPhysicalGroup(dim, tags, tag)
-            gmsh.model.setPhysicalName(dim, tag, name)
-        gmsh.model.mesh.generate(2)
-    model = gmsh.model if comm.rank == 0 else None
-    try:
+    with half_recombined_square(comm, lambda i: 9 if i in (2, 5, 6) else 5, [("edge", range(6))]) as model:
         with pytest.raises(ValueError, match="both triangles and quadrilaterals.*cells='quadrilateral'"):
             dc.from_gmsh(model, 3)
         meshes = [dc.from_gmsh(model, 3, cells=shape) for shape in ("triangle", "quadrilateral")]
-    finally:
-        if comm.rank == 0:
-            gmsh.finalize()
     assert [tm.mesh.topology.cell_name() for tm in meshes] == ["triangle", "quadrilateral"]
     sc = dc.Scene(large_rotations=False)
     parts = [sc.add_shell(tm, "plate", thickness=t, material=dc.Elastic(E_, nu)) for tm in meshes]

@@ -172,7 +172,7 @@ class Scene:
 
     def add_shell(self, tmesh: TaggedMesh, where: str | None = None, *, thickness: float | None = None,
                   material=None, section=None, axis=None, membrane: str | None = None, drilling: float = 1e-2,
-                  kinematics: str = "kirchhoff") -> PartRef:
+                  kinematics: str = "kirchhoff", shallow: bool = False) -> PartRef:
         """Flat co-rotational shells on group ``where`` of a triangle or quadrilateral mesh in space.
 
         The section: ``thickness`` and ``material`` (``dc.Elastic``, or ``dc.Orthotropic``, a single
@@ -195,10 +195,20 @@ class Scene:
         transverse shear of laminates: bilinear rotations make it stiffer than the DKQ where
         curvature changes fast on coarse meshes). A quadrilateral mesh given shells carries its
         membranes with the same element (add its shells first).
+
+        ``shallow``: the co-rotational local law adds the membrane strain of each element's own
+        bending, von Kármán's ½w,ᵢw,ⱼ of its discrete Kirchhoff slopes (as the beams' shallow-arch
+        strain; :mod:`dolfinx_corot.elements.shallow_shell`): the membrane forces then act on the
+        element's bending (initial-stress stiffness). It makes coarse meshes of shells that buckle
+        or snap under compression far more accurate (docs/theory.md, "The shallow-shell local
+        law"); where coarse flat facets unbend a curved shell far (a cylinder pulled flat), it
+        stiffens them. A geometrically linear analysis ignores it.
         """
+        if not isinstance(shallow, (bool, np.bool_)):
+            raise ValueError(f"shell '{where}': shallow = {shallow!r} must be True or False")
         section, density = self._shell_section("shell", where, thickness, material, section)
         model = self._model(tmesh, kind="shell")
-        ref = model.add_shell(where, section, float(drilling), membrane, kinematics, axis)
+        ref = model.add_shell(where, section, float(drilling), membrane, kinematics, axis, bool(shallow))
         model.set_mass(ref, density, section.thickness)
         return ref
 

@@ -8,7 +8,10 @@ from dolfinx_corot.kernels import shell3d as k
 
 PROPS = law.isotropic_props(2.1e4, 0.3, 0.05, 1e-2, True, True)
 KINDS = {"shell": PROPS, "shell_cst": law.isotropic_props(2.1e4, 0.3, 0.05, 1e-2, True, False),
-         "membrane": law.isotropic_props(2.1e4, 0.3, 0.05, 0.0, False, False)}
+         "membrane": law.isotropic_props(2.1e4, 0.3, 0.05, 0.0, False, False),
+         # the shallow-shell term of the local law (elements/shallow_shell.py)
+         "shell_shallow": law.isotropic_props(2.1e4, 0.3, 0.05, 1e-2, True, True, shallow=True),
+         "shell_cst_shallow": law.isotropic_props(2.1e4, 0.3, 0.05, 1e-2, True, False, shallow=True)}
 
 
 def _eval(X, S, large=True, props=PROPS):

@@ -14,6 +14,10 @@ E, NU, T = 2.1e4, 0.3, 0.05
 PROPS = law.isotropic_props(E, NU, T, 1e-2)  # DKQ
 MITC4 = law.isotropic_props(E, NU, T, 1e-2, kirchhoff=False)
 KINEMATICS = {"kirchhoff": PROPS, "mindlin": MITC4}
+# the tangents with the shallow-shell term of the local law as well (elements/shallow_shell.py)
+SHALLOW = law.isotropic_props(E, NU, T, 1e-2, shallow=True)
+TANGENTS = {**KINEMATICS, "kirchhoff_shallow": SHALLOW,
+            "mindlin_shallow": law.isotropic_props(E, NU, T, 1e-2, kirchhoff=False, shallow=True)}
 C = E / (1 - NU**2) * np.array([[1, NU, 0], [NU, 1, 0], [0, 0, (1 - NU) / 2]])
 # a warped quadrilateral in DOLFINx's vertex order (0, 0), (1, 0), (0, 1), (1, 1)
 XW = np.array([[0.0, 0.0, 0.0], [1.1, 0.1, 0.05], [-0.1, 0.05, 1.0], [1.0, 0.0, 0.95]])
@@ -119,12 +123,12 @@ def test_rigid_body_modes_and_energies(kinematics):
     assert 0.5 * d @ K @ d == pytest.approx(0.5 * E * kap**2 * b**3 / 12 * T * a, rel=1e-12)
 
 
-@pytest.mark.parametrize("kinematics", list(KINEMATICS))
+@pytest.mark.parametrize("kinematics", list(TANGENTS))
 def test_closed_form_tangent_equals_complex_step_tangent(kinematics):
     """The tangent (closed form, the frame spin's variation by complex step) against complex-step
     differentiation of the internal force, at random states of a warped element with rigid
     rotations of several radians and nodal rotations up to 1.5 rad: 1e-10."""
-    props = KINEMATICS[kinematics]
+    props = TANGENTS[kinematics]
     rng = np.random.default_rng(3)
     for trial in range(12):
         X = XW + 0.1 * rng.normal(size=(4, 3)) if trial % 3 else XW
@@ -136,11 +140,11 @@ def test_closed_form_tangent_equals_complex_step_tangent(kinematics):
         assert np.abs(K1 - K2).max() < 1e-10 * np.abs(K2).max()
 
 
-@pytest.mark.parametrize("kinematics", list(KINEMATICS))
+@pytest.mark.parametrize("kinematics", list(TANGENTS))
 def test_tangent_matches_finite_differences(kinematics):
     """Central differences of the internal force, translations added and rotations updated
     multiplicatively (R ← exp(h e_k) R, as Newton updates them), h = 1e-6: 1e-6."""
-    props = KINEMATICS[kinematics]
+    props = TANGENTS[kinematics]
     rng = np.random.default_rng(4)
     for _ in range(4):
         S, _, _ = _state(rng, XW, strain=0.05, rot_scale=0.5)
@@ -162,12 +166,13 @@ def test_tangent_matches_finite_differences(kinematics):
         assert np.abs(K - Kfd).max() < 1e-6 * np.abs(K).max()
 
 
-def test_objectivity_under_rotations_up_to_ten_radians():
+@pytest.mark.parametrize("props", [PROPS, SHALLOW], ids=["linear", "shallow"])
+def test_objectivity_under_rotations_up_to_ten_radians(props):
     """A deformed state moved rigidly (rotations of 0.5 to 10 rad about random axes): the nodal
     forces turn with it, and a rigid motion of the undeformed element gives no force (1e-10)."""
     rng = np.random.default_rng(6)
     S, _, _ = _state(rng, XW, rigid=0.0)
-    f, K = _eval(XW, S)
+    f, K = _eval(XW, S, props=props)
     x = XW + S[:, :3]
     for angle in (0.5, 3.0, 6.0, 10.0):
         axis = rng.normal(size=3)
@@ -177,7 +182,7 @@ def test_objectivity_under_rotations_up_to_ten_radians():
         for a in range(4):
             S2[a, :3] = Q @ x[a] + t - XW[a]
             S2[a, 3:] = rot.quat_from_matrix(Q @ rot.quat_to_matrix(S[a, 3:].copy()))
-        f2, K2 = _eval(XW, S2)
+        f2, K2 = _eval(XW, S2, props=props)
         fr = np.concatenate([Q @ f[3 * b:3 * b + 3] for b in range(8)])
         np.testing.assert_allclose(f2, fr, atol=1e-10 * np.abs(f).max())
         L = np.kron(np.eye(8), Q)
@@ -186,7 +191,7 @@ def test_objectivity_under_rotations_up_to_ten_radians():
         for a in range(4):
             S0[a, :3] = Q @ XW[a] + t - XW[a]
             S0[a, 3:] = rot.quat_from_matrix(Q)
-        assert np.abs(_eval(XW, S0)[0]).max() < 1e-10 * np.abs(f).max()
+        assert np.abs(_eval(XW, S0, props=props)[0]).max() < 1e-10 * np.abs(f).max()
 
 
 def test_frame_and_forces_do_not_depend_on_the_first_node():

@@ -33,9 +33,10 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from ..elements import shallow_shell
 from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
 from .frame_triangle import _dTiT_m
-from .transform import (add_omega_w, frame_axes, linear_force, local_coordinates, positions, rotate_columns,
+from .transform import (add_omega_w, force, frame_axes, linear_force, local_coordinates, positions, rotate_columns,
                         stiffness, subtract_spin_g_omega, to_global)
 
 H = 1e-30  # complex step of the frame spin's variation
@@ -261,25 +262,31 @@ def shell_basic(X, u, R, R0, xbar0, dbar, B):
 
 
 @numba.njit(cache=True)
-def shell_force(X, u, R, R0, xbar0, Kbar, f):
-    """f (24,) = Λᵀ B_lᵀ K̄ d̄ of a four-node shell (real or complex)."""
+def shell_force(X, u, R, R0, xbar0, Kbar, sdata, f):
+    """f (24,) = Λᵀ B_lᵀ f̄(d̄) of a four-node shell (real or complex); f̄ of the local law K̄ d̄
+    plus the shallow-shell term of sdata (:mod:`dolfinx_corot.elements.shallow_shell`)."""
     dt = u.dtype
     Rr, xbar, th, Ti, Om, Bl, dbar = shell_parts(X, u, R, R0, xbar0)
     fbar = np.empty(24, dtype=dt)
     g = np.empty(24, dtype=dt)
-    linear_force(Bl, Kbar, dbar, fbar, g, 24, 24)
+    if shallow_shell.active(sdata):
+        shallow_shell.force(dbar, Kbar, sdata, 4, fbar)
+        force(Bl, fbar, g, 24, 24)
+    else:
+        linear_force(Bl, Kbar, dbar, fbar, g, 24, 24)
     for b in range(8):
         for k in range(3):
             f[3 * b + k] = Rr[k, 0] * g[3 * b] + Rr[k, 1] * g[3 * b + 1] + Rr[k, 2] * g[3 * b + 2]
 
 
 @numba.njit(cache=True)
-def shell_force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K):
-    """f = Bᵀ K̄ d̄ and its consistent tangent K = ∂f/∂d of a four-node shell.
+def shell_force_and_tangent(X, u, R, R0, xbar0, Kbar, sdata, f, K):
+    """f = Bᵀ f̄(d̄) (see :func:`shell_force`) and its consistent tangent K = ∂f/∂d of a
+    four-node shell.
 
-    In local components, with g = B_lᵀ f̄ and v = Σ_a(n_a × x̄_a − T_a⁻ᵀ m_a) (n_a, m_a the
-    local nodal forces and moments):
-    K^l = B_lᵀ K̄ B_l − S(g) Ω + Σ_a ∂(Ωᵀv)/∂x̄_a B_{u,a}
+    In local components, with g = B_lᵀ f̄, v = Σ_a(n_a × x̄_a − T_a⁻ᵀ m_a) (n_a, m_a the
+    local nodal forces and moments) and K̄_t = ∂f̄/∂d̄:
+    K^l = B_lᵀ K̄_t B_l − S(g) Ω + Σ_a ∂(Ωᵀv)/∂x̄_a B_{u,a}
           + Ωᵀ Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) + Σ_a E_aᵀ M_a B_{θ,a},
     M_a = ∂(T⁻¹(θ̄_a)ᵀ m_a)/∂θ̄_a in closed form (:func:`frame_triangle._dTiT_m`), ∂(Ωᵀv)/∂x̄
     by complex step of :func:`shape_spin`; K = Λᵀ K^l Λ and f = Λᵀ g. The derivation is the
@@ -287,9 +294,15 @@ def shell_force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K):
     Rr, xbar, th, Ti, Om, Bl, dbar = shell_parts(X, u, R, R0, xbar0)
     fbar = np.empty(24)
     g = np.empty(24)
-    linear_force(Bl, Kbar, dbar, fbar, g, 24, 24)
     Kl = np.empty((24, 24))
-    stiffness(Bl, Kbar, Kl, 24, 24)
+    if shallow_shell.active(sdata):
+        Kt = np.empty((24, 24))
+        shallow_shell.force_and_tangent(dbar, Kbar, sdata, 4, fbar, Kt)
+        force(Bl, fbar, g, 24, 24)
+        stiffness(Bl, Kt, Kl, 24, 24)
+    else:
+        linear_force(Bl, Kbar, dbar, fbar, g, 24, 24)
+        stiffness(Bl, Kbar, Kl, 24, 24)
     subtract_spin_g_omega(Kl, g, Om, 24)
     v = np.zeros(3)
     M = np.zeros((4, 3, 3))

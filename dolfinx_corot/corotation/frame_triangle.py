@@ -37,8 +37,9 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from ..elements import shallow_shell
 from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
-from .transform import (add_omega_w, frame_axes, linear_force, local_coordinates, positions, rotate_columns,
+from .transform import (add_omega_w, force, frame_axes, linear_force, local_coordinates, positions, rotate_columns,
                         stiffness, subtract_spin_g_omega, to_global)
 
 
@@ -150,13 +151,18 @@ def basic(X, u, R, R0, xbar0, dbar, B, rotations=True):
 
 
 @numba.njit(cache=True)
-def internal_force(X, u, R, R0, xbar0, Kbar, f, rotations=True):
-    """f (18,) = Λᵀ B_lᵀ K̄ d̄ (linear local law), without forming B = B_l Λ (real or complex)."""
+def internal_force(X, u, R, R0, xbar0, Kbar, sdata, f, rotations=True):
+    """f (18,) = Λᵀ B_lᵀ f̄(d̄), without forming B = B_l Λ (real or complex); f̄ of the local law
+    K̄ d̄ plus the shallow-shell term of sdata (:mod:`dolfinx_corot.elements.shallow_shell`)."""
     dt = u.dtype
     Rr, l, b1, b2, xbar, th, Ti, Om, Bl, dbar = parts(X, u, R, R0, xbar0, rotations)
     fbar = np.empty(18, dtype=dt)
     g = np.empty(18, dtype=dt)
-    linear_force(Bl, Kbar, dbar, fbar, g, 18, 18)
+    if shallow_shell.active(sdata):
+        shallow_shell.force(dbar, Kbar, sdata, 3, fbar)
+        force(Bl, fbar, g, 18, 18)
+    else:
+        linear_force(Bl, Kbar, dbar, fbar, g, 18, 18)
     for b in range(6):
         for k in range(3):
             f[3 * b + k] = Rr[k, 0] * g[3 * b] + Rr[k, 1] * g[3 * b + 1] + Rr[k, 2] * g[3 * b + 2]
@@ -211,21 +217,28 @@ def _dTiT_m_complex_step(th, m, M):
 
 
 @numba.njit(cache=True)
-def force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K, rotations=True):
-    """f = Bᵀ K̄ d̄ (linear local law f̄ = K̄ d̄) and its consistent tangent K = ∂f/∂d in closed form.
+def force_and_tangent(X, u, R, R0, xbar0, Kbar, sdata, f, K, rotations=True):
+    """f = Bᵀ f̄(d̄) (the local law of :func:`internal_force`) and its consistent tangent
+    K = ∂f/∂d in closed form.
 
     In local components (d^l = Λd, Λ = blockdiag(R_rᵀ)), with g = B_lᵀ f̄, v = Σ_a(n_a × x̄_a − T_a⁻ᵀ m_a)
-    (n_a, m_a the local nodal forces and moments), ω = Ω d^l the frame spin:
-    K^l = B_lᵀ K̄ B_l − S(g) Ω + ∂(Ωᵀ v)/∂(l, b₁, b₂)·∂(l, b₁, b₂)/∂d^l
+    (n_a, m_a the local nodal forces and moments), ω = Ω d^l the frame spin, K̄_t = ∂f̄/∂d̄:
+    K^l = B_lᵀ K̄_t B_l − S(g) Ω + ∂(Ωᵀ v)/∂(l, b₁, b₂)·∂(l, b₁, b₂)/∂d^l
           + Ωᵀ Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) + Σ_a E_aᵀ M_a B_{θ,a},
     M_a = ∂(T⁻¹(θ̄_a)ᵀ m_a)/∂θ̄_a; then K = Λᵀ K^l Λ and f = Λᵀ g.
     """
     Rr, l, b1, b2, xbar, th, Ti, Om, Bl, dbar = parts(X, u, R, R0, xbar0, rotations)
     fbar = np.empty(18)
     g = np.empty(18)
-    linear_force(Bl, Kbar, dbar, fbar, g, 18, 18)
     Kl = np.empty((18, 18))
-    stiffness(Bl, Kbar, Kl, 18, 18)  # material part
+    if shallow_shell.active(sdata):
+        Kt = np.empty((18, 18))
+        shallow_shell.force_and_tangent(dbar, Kbar, sdata, 3, fbar, Kt)
+        force(Bl, fbar, g, 18, 18)
+        stiffness(Bl, Kt, Kl, 18, 18)
+    else:
+        linear_force(Bl, Kbar, dbar, fbar, g, 18, 18)
+        stiffness(Bl, Kbar, Kl, 18, 18)
     subtract_spin_g_omega(Kl, g, Om, 18)
     # v and M_a
     v = np.zeros(3)

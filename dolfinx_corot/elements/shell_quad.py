@@ -35,17 +35,21 @@ x–y plane (the projection of a warped element onto its mean plane), bilinear s
   :math:`v_p = v + z\theta_x`, i.e. :math:`\bar{\mathbf K} = \mathbf W^T\mathbf K_{flat}\mathbf W`.
 
 ``props`` (:data:`NPROPS`): E, ν, t (a reference material and the thickness, for contact
-offsets and face stresses), α (drilling factor), A (3 × 3), B (3 × 3), D (3 × 3), S (2 × 2) row-major.
+offsets and face stresses), α (drilling factor), A (3 × 3), B (3 × 3), D (3 × 3), S (2 × 2) row-major,
+the bending kinematics (:data:`KIRCHHOFF`) and the shallow-shell switch (:data:`SHALLOW`).
 """
 from __future__ import annotations
 
 import numba
 import numpy as np
 
+from . import shallow_shell
+
 E_, NU, T, ALPHA = range(4)
 A0, B0, D0, S0 = 4, 13, 22, 31
 KIRCHHOFF = 35  # 1: discrete Kirchhoff bending (DKQ), 0: MITC4 (Reissner–Mindlin)
-NPROPS = 36
+SHALLOW = 36  # 1: the shallow-shell term in the co-rotational local law (:mod:`.shallow_shell`)
+NPROPS = 37
 KAPPA = 5.0 / 6.0  # shear correction factor of a homogeneous plate
 
 _G = 1.0 / np.sqrt(3.0)
@@ -53,9 +57,10 @@ _GAUSS = np.array([[-_G, -_G], [_G, -_G], [_G, _G], [-_G, _G]])
 _NODES = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
 
 
-def isotropic_props(E: float, nu: float, t: float, alpha: float, kirchhoff: bool = True) -> np.ndarray:
+def isotropic_props(E: float, nu: float, t: float, alpha: float, kirchhoff: bool = True,
+                    shallow: bool = False) -> np.ndarray:
     """props of a homogeneous isotropic shell (see the module's docstring); bending by the DKQ
-    (``kirchhoff``) or MITC4."""
+    (``kirchhoff``) or MITC4; ``shallow``: the shallow-shell term (:mod:`.shallow_shell`)."""
     c = E / (1.0 - nu * nu)
     C = np.array([[c, c * nu, 0.0], [c * nu, c, 0.0], [0.0, 0.0, 0.5 * c * (1.0 - nu)]])
     G = E / (2.0 * (1.0 + nu))
@@ -65,6 +70,7 @@ def isotropic_props(E: float, nu: float, t: float, alpha: float, kirchhoff: bool
     props[D0:D0 + 9] = (t ** 3 / 12.0 * C).ravel()
     props[S0:S0 + 4] = (KAPPA * G * t * np.eye(2)).ravel()
     props[KIRCHHOFF] = 1.0 if kirchhoff else 0.0
+    props[SHALLOW] = 1.0 if shallow else 0.0
     return props
 
 
@@ -98,7 +104,27 @@ def dkq_B(xy, xi, eta):
     serendipity field; at the mid-sides the Kirchhoff constraints fix them: the tangential
     component follows the cubic deflection of the edge, β_s = −(3/2l)(w_j − w_i) − ¼(β_si + β_sj),
     the normal one is linear, β_n = ½(β_ni + β_nj)."""
-    S = np.zeros((16, 12))  # (βx, βy) at the 8 nodes from the 12 corner dofs
+    S = _dkq_slope_nodes(xy)
+    d = _serendipity(xi, eta)
+    _, _, J, det = shape(xy, xi, eta)
+    B = np.zeros((3, 12))
+    for n in range(8):
+        nx = (J[1, 1] * d[0, n] - J[0, 1] * d[1, n]) / det
+        ny = (-J[1, 0] * d[0, n] + J[0, 0] * d[1, n]) / det
+        for col in range(12):
+            bx = S[2 * n, col]
+            by = S[2 * n + 1, col]
+            B[0, col] += nx * bx
+            B[1, col] += ny * by
+            B[2, col] += ny * bx + nx * by
+    return B
+
+
+@numba.njit(cache=True)
+def _dkq_slope_nodes(xy):
+    """S (16, 12): the DKQ's rotations of the normal (βx, βy) at the corners, then at the
+    mid-sides of edges 01, 12, 23, 30, from the corner dofs (w, θx, θy) (see :func:`dkq_B`)."""
+    S = np.zeros((16, 12))
     for a in range(4):
         S[2 * a, 3 * a + 2] = 1.0
         S[2 * a + 1, 3 * a + 1] = -1.0
@@ -120,19 +146,84 @@ def dkq_B(xy, xi, eta):
         for col in range(12):
             S[8 + 2 * k, col] = c * rs[col] + s * rn[col]
             S[8 + 2 * k + 1, col] = s * rs[col] - c * rn[col]
-    d = _serendipity(xi, eta)
-    _, _, J, det = shape(xy, xi, eta)
-    B = np.zeros((3, 12))
+    return S
+
+
+@numba.njit(cache=True)
+def _serendipity_values(xi, eta):
+    """The 8-node serendipity functions at (ξ, η), ordered as in :func:`_serendipity`."""
+    N = np.empty(8)
+    for a in range(4):
+        xa, ya = _NODES[a, 0], _NODES[a, 1]
+        N[a] = 0.25 * (1.0 + xi * xa) * (1.0 + eta * ya) * (xi * xa + eta * ya - 1.0)
+    for k in range(4):
+        xm = 0.5 * (_NODES[k, 0] + _NODES[(k + 1) % 4, 0])
+        ym = 0.5 * (_NODES[k, 1] + _NODES[(k + 1) % 4, 1])
+        if xm == 0.0:
+            N[4 + k] = 0.5 * (1.0 - xi * xi) * (1.0 + eta * ym)
+        else:
+            N[4 + k] = 0.5 * (1.0 + xi * xm) * (1.0 - eta * eta)
+    return N
+
+
+@numba.njit(cache=True)
+def slopes(xy, xi, eta):
+    """The DKQ's rotations of the normal (βx, βy) = −(w,x, w,y) at (ξ, η), (2, 12) on the plate
+    dofs (w, θx, θy) per node. The MITC4 uses the same field for its shallow-shell term: its own
+    bilinear rotations carry no edge deflection."""
+    N = _serendipity_values(xi, eta)
+    S = _dkq_slope_nodes(xy)
+    out = np.zeros((2, 12))
     for n in range(8):
-        nx = (J[1, 1] * d[0, n] - J[0, 1] * d[1, n]) / det
-        ny = (-J[1, 0] * d[0, n] + J[0, 0] * d[1, n]) / det
         for col in range(12):
-            bx = S[2 * n, col]
-            by = S[2 * n + 1, col]
-            B[0, col] += nx * bx
-            B[1, col] += ny * by
-            B[2, col] += ny * bx + nx * by
-    return B
+            out[0, col] += N[n] * S[2 * n, col]
+            out[1, col] += N[n] * S[2 * n + 1, col]
+    return out
+
+
+_G3 = np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
+_W3 = np.array([5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0])
+
+
+@numba.njit(cache=True)
+def shallow_data(xbar0, props, out):
+    """out (:func:`.shallow_shell.size` (4)): the shallow-shell term of the co-rotational
+    quadrilateral (:mod:`.shallow_shell`) on the projected corners: G of the DKQ's slopes (3 × 3
+    Gauss points, exact), C_N the mean of A ε + B κ of the bilinear membrane field and the
+    bending field over the cell (the incompatible modes have no mean strain), through the rigid
+    links of a warped cell; A_m; the area (0: switched off)."""
+    if props[SHALLOW] == 0.0:
+        out[:] = 0.0
+        return
+    xy = np.ascontiguousarray(xbar0[:, :2])
+    A = props[A0:A0 + 9].copy().reshape(3, 3)
+    Bc = props[B0:B0 + 9].copy().reshape(3, 3)
+    kirchhoff = props[KIRCHHOFF] != 0.0
+    _, _, J0, det0 = shape(xy, 0.0, 0.0)
+    G = np.zeros((3, 12, 12))
+    area = 0.0
+    for i in range(3):
+        for j in range(3):
+            _, _, _, det = shape(xy, _G3[i], _G3[j])
+            w = _W3[i] * _W3[j] * det
+            area += w
+            shallow_shell.add_slope_products(slopes(xy, _G3[i], _G3[j]), w, G)
+    G /= area
+    Cf = np.zeros((3, 24))
+    for q in range(4):
+        Be, Bk, _, _, det = _strains(xy, _GAUSS[q, 0], _GAUSS[q, 1], J0, det0, kirchhoff)
+        Nq = A @ np.ascontiguousarray(Be[:, :24]) + Bc @ np.ascontiguousarray(Bk[:, :24])
+        Cf += det * Nq
+    Cf /= area
+    CN = np.zeros((3, 24))  # C_f W: u_p = u − z θy, v_p = v + z θx
+    for k in range(3):
+        for j in range(24):
+            CN[k, j] = Cf[k, j]
+        for a in range(4):
+            z = xbar0[a, 2]
+            CN[k, 6 * a + 4] -= z * Cf[k, 6 * a]
+            CN[k, 6 * a + 3] += z * Cf[k, 6 * a + 1]
+    shallow_shell.pack(G, CN, A, area, out)
 
 
 @numba.njit(cache=True)

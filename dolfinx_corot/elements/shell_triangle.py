@@ -29,8 +29,8 @@ the local x–y plane. Material: isotropic, plane stress, thickness t.
   :math:`\boldsymbol\kappa = (\beta_{x,x}, \beta_{y,y}, \beta_{x,y} + \beta_{y,x})`,
   :math:`\mathbf K_b = \int\mathbf B_b^T\mathbf D_b\mathbf B_b\,dA` by a 3-point rule (exact).
 
-``props = (E, nu, t, alpha, bending, opt, A (3 × 3), B (3 × 3), D (3 × 3))``, the matrices
-row-major: the section N = Aε + Bκ, M = Bε + Dκ (κ of the rotations of the normal, u(z) = zβ;
+``props = (E, nu, t, alpha, bending, opt, A (3 × 3), B (3 × 3), D (3 × 3), shallow)``, the
+matrices row-major: the section N = Aε + Bκ, M = Bε + Dκ (κ of the rotations of the normal, u(z) = zβ;
 isotropic: A = tC, B = 0, D = t³C/12, see :func:`isotropic_props`; laminates:
 :class:`dolfinx_corot.sections.Laminate`). The membranes take A (OPT: D = A/t in its formulas,
 β₀ from ν = A12/A22), the DKT takes D; B couples the constant membrane strain of the CST with
@@ -45,17 +45,22 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from . import shallow_shell
+
 E_, NU, T, ALPHA, BENDING, OPT = range(6)
 A0, B0, D0 = 6, 15, 24
-NPROPS = 33
+SHALLOW = 33  # 1: the shallow-shell term in the co-rotational local law (:mod:`.shallow_shell`)
+NPROPS = 34
 
 
-def isotropic_props(E: float, nu: float, t: float, alpha: float, bending: bool, opt: bool) -> np.ndarray:
+def isotropic_props(E: float, nu: float, t: float, alpha: float, bending: bool, opt: bool,
+                    shallow: bool = False) -> np.ndarray:
     """props of a homogeneous isotropic shell or membrane (see the module's docstring)."""
     c = E / (1.0 - nu * nu)
     C = np.array([[c, c * nu, 0.0], [c * nu, c, 0.0], [0.0, 0.0, 0.5 * c * (1.0 - nu)]])
     props = np.zeros(NPROPS)
     props[:6] = E, nu, t, alpha, float(bending), float(opt)
+    props[SHALLOW] = float(shallow)
     props[A0:A0 + 9] = (t * C).ravel()
     if bending:
         props[D0:D0 + 9] = (t ** 3 / 12.0 * C).ravel()
@@ -217,6 +222,72 @@ def _dkt_midside(xy):
 
 
 @numba.njit(cache=True)
+def _dkt_slope_nodes(xy):
+    """S (12, 9): the slopes (βx, βy) at the corners 1–3, then at the mid-sides of edges 23, 31,
+    12, from the corner dofs (w, θx, θy)."""
+    S = np.zeros((12, 9))
+    for a in range(3):
+        S[2 * a, 3 * a + 2] = -1.0
+        S[2 * a + 1, 3 * a + 1] = 1.0
+    S[6:, :] = _dkt_midside(xy)
+    return S
+
+
+@numba.njit(cache=True)
+def slopes(xy, xi, eta):
+    """The DKT's slopes (βx, βy) = (w,x, w,y) at (ξ, η), (2, 9) on the dofs (w, θx, θy) of nodes 1–3."""
+    L1 = 1.0 - xi - eta
+    N = np.array([L1 * (2.0 * L1 - 1.0), xi * (2.0 * xi - 1.0), eta * (2.0 * eta - 1.0),
+                  4.0 * xi * eta, 4.0 * eta * L1, 4.0 * L1 * xi])
+    S = _dkt_slope_nodes(xy)
+    out = np.zeros((2, 9))
+    for n in range(6):
+        for col in range(9):
+            out[0, col] += N[n] * S[2 * n, col]
+            out[1, col] += N[n] * S[2 * n + 1, col]
+    return out
+
+
+# Strang & Fix's six-point rule, degree 4 (barycentric weights summing to 1)
+_Q4 = np.array([[0.445948490915965, 0.445948490915965, 0.223381589678011],
+                [0.108103018168070, 0.445948490915965, 0.223381589678011],
+                [0.445948490915965, 0.108103018168070, 0.223381589678011],
+                [0.091576213509771, 0.091576213509771, 0.109951743655322],
+                [0.816847572980459, 0.091576213509771, 0.109951743655322],
+                [0.091576213509771, 0.816847572980459, 0.109951743655322]])
+
+
+@numba.njit(cache=True)
+def shallow_data(xy, props, out):
+    """out (:func:`.shallow_shell.size` (3)): the shallow-shell term of the co-rotational
+    triangle (:mod:`.shallow_shell`): G of the DKT's slopes (exact: degree 4), C_N from the
+    CST strain and the curvature at the centroid, A_m, the area (0: switched off, and for a
+    membrane)."""
+    G = np.zeros((3, 9, 9))
+    CN = np.zeros((3, 18))
+    Am = props[A0:A0 + 9].copy().reshape(3, 3)
+    out[:] = 0.0
+    if props[BENDING] == 0.0 or props[SHALLOW] == 0.0:
+        return
+    Bc = props[B0:B0 + 9].copy().reshape(3, 3)
+    Bm, A2 = membrane_B(xy)
+    for q in range(6):
+        S = slopes(xy, _Q4[q, 0], _Q4[q, 1])
+        shallow_shell.add_slope_products(S, _Q4[q, 2], G)
+    AB = Am @ Bm
+    for a in range(3):
+        for k in range(3):
+            CN[k, 6 * a] = AB[k, 2 * a]
+            CN[k, 6 * a + 1] = AB[k, 2 * a + 1]
+    BB = Bc @ bending_B(xy, 1.0 / 3.0, 1.0 / 3.0)  # κ = −(the DKT's curvature of the slopes)
+    for a in range(3):
+        for m in range(3):
+            for k in range(3):
+                CN[k, 6 * a + 2 + m] -= BB[k, 3 * a + m]
+    shallow_shell.pack(G, CN, Am, 0.5 * A2, out)
+
+
+@numba.njit(cache=True)
 def bending_B(xy, xi, eta):
     """DKT curvature matrix (3, 9) at (ξ, η) for the dofs (w, θx, θy) of nodes 1–3."""
     L1 = 1.0 - xi - eta
@@ -242,12 +313,7 @@ def bending_B(xy, xi, eta):
     for n in range(6):
         dNx[0, n] = (J[1, 1] * dN[0, n] - J[0, 1] * dN[1, n]) / det
         dNx[1, n] = (-J[1, 0] * dN[0, n] + J[0, 0] * dN[1, n]) / det
-    # slopes at the 6 nodes from the 9 corner dofs
-    S = np.zeros((12, 9))  # rows: βx1, βy1, βx2, βy2, βx3, βy3, then mid-sides
-    for a in range(3):
-        S[2 * a, 3 * a + 2] = -1.0
-        S[2 * a + 1, 3 * a + 1] = 1.0
-    S[6:, :] = _dkt_midside(xy)
+    S = _dkt_slope_nodes(xy)
     B = np.zeros((3, 9))
     for n in range(6):
         for col in range(9):

@@ -30,24 +30,26 @@ import numpy as np
 
 from ..corotation import frame_triangle as frame
 from ..corotation.transform import stiffness
+from ..elements import shallow_shell
 from ..elements import shell_triangle as law
 from .spatial import (H, SYMMETRIZED, last_node_columns, nodal_states, pack_constants, perturb,
-                      rotation_vector_dofs, since_activation, symmetrize, unpack_constants)
+                      rotation_vector_dofs, shallow_constants, since_activation, symmetrize, unpack_constants)
 from . import RESULTANTS  # the names of resultants()' components
 from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
 NDOF = 18
 NSTATE = 7
-NEDATA = 9 + 9 + 18 * 18  # per-cell constants: R0, x̄0, K̄ (computed once, see element_data)
+NSHALLOW = shallow_shell.size(3)
+NEDATA = 9 + 9 + 18 * 18 + NSHALLOW  # per-cell constants: R0, x̄0, K̄, shallow-shell data (once per cell)
 NCOEF = 3 * NSTATE + law.NPROPS + NEDATA
 _P0 = 3 * NSTATE
 _E0 = 3 * NSTATE + law.NPROPS
 
 
 @numba.njit(cache=True)
-def _force(X, u, R, R0, xbar0, Kbar, f, rotations):
-    """f (18,) = Bᵀ K̄ d̄ at the given configuration (real or complex)."""
-    frame.internal_force(X, u, R, R0, xbar0, Kbar, f, rotations)
+def _force(X, u, R, R0, xbar0, Kbar, sdata, f, rotations):
+    """f (18,) = Bᵀ f̄(d̄) at the given configuration (real or complex)."""
+    frame.internal_force(X, u, R, R0, xbar0, Kbar, sdata, f, rotations)
 
 
 @numba.njit(cache=True)
@@ -56,15 +58,20 @@ def _setup(X, props):
     xbar0 = np.empty((3, 3))
     frame.initial(X, R0, xbar0)
     Kbar = np.empty((18, 18))
-    law.local_stiffness(np.ascontiguousarray(xbar0[:, :2]), props, Kbar)
-    return R0, xbar0, Kbar
+    xy = np.ascontiguousarray(xbar0[:, :2])
+    law.local_stiffness(xy, props, Kbar)
+    sdata = np.empty(NSHALLOW)
+    law.shallow_data(xy, props, sdata)
+    return R0, xbar0, Kbar, sdata
 
 
 @numba.njit(cache=True)
 def element_data(X, props, out):
-    """The constants of one element, out (NEDATA,) = (R0, x̄0, K̄) flattened (computed once per cell)."""
-    R0, xbar0, Kbar = _setup(X, props)
+    """The constants of one element, out (NEDATA,) = (R0, x̄0, K̄, shallow-shell data) flattened
+    (computed once per cell)."""
+    R0, xbar0, Kbar, sdata = _setup(X, props)
     pack_constants(R0, xbar0, Kbar, out)
+    out[9 + 9 + 18 * 18:] = sdata
 
 
 @numba.njit(cache=True)
@@ -88,25 +95,26 @@ def corotational_cached(X, S, props, edata, f, K, tangent=True):
     """:func:`corotational` with the element constants given (see :func:`element_data`);
     with tangent False, f alone (f = Bᵀ K̄ d̄, K untouched)."""
     R0, xbar0, Kbar = unpack_constants(edata, 3, 18)
+    sdata = shallow_constants(edata, 3, 18)
     u = np.empty((3, 3))
     R = np.empty((3, 3, 3))
     nodal_states(S, u, R)
     rotations = props[law.BENDING] != 0.0
     if tangent:
-        frame.force_and_tangent(X, u, R, R0, xbar0, Kbar, f, K, rotations)
+        frame.force_and_tangent(X, u, R, R0, xbar0, Kbar, sdata, f, K, rotations)
     else:
-        _force(X, u, R, R0, xbar0, Kbar, f, rotations)
+        _force(X, u, R, R0, xbar0, Kbar, sdata, f, rotations)
 
 
 @numba.njit(cache=True)
 def corotational_complex_step(X, S, props, f, K):
     """X (3, 3) initial nodes, S (3, 7) nodal states → f (18,), K (18, 18) (complex-step tangent)."""
-    R0, xbar0, Kbar = _setup(X, props)
+    R0, xbar0, Kbar, sdata = _setup(X, props)
     u = np.empty((3, 3))
     R = np.empty((3, 3, 3))
     nodal_states(S, u, R)
     rotations = props[law.BENDING] != 0.0
-    _force(X, u, R, R0, xbar0, Kbar, f, rotations)
+    _force(X, u, R, R0, xbar0, Kbar, sdata, f, rotations)
     uc = u.astype(np.complex128)
     Rc = R.astype(np.complex128)
     up = np.empty_like(uc)
@@ -114,7 +122,7 @@ def corotational_complex_step(X, S, props, f, K):
     fc = np.empty(18, dtype=np.complex128)
     for j in range(12):  # nodes 1 and 2; node 3 follows from invariance
         perturb(uc, Rc, j, up, Rp)
-        _force(X, up, Rp, R0, xbar0, Kbar, fc, rotations)
+        _force(X, up, Rp, R0, xbar0, Kbar, sdata, fc, rotations)
         for i in range(18):
             K[i, j] = fc[i].imag / H
     last_node_columns(f, X, u, K)
@@ -201,6 +209,8 @@ def resultants(X, S, props, edata, large_rotations, out, axes):
     Bm, _ = law.membrane_B(xy)
     uv = np.array([dbar[0], dbar[1], dbar[6], dbar[7], dbar[12], dbar[13]])
     eps = Bm @ uv
+    if large_rotations:  # the shallow-shell strain (membrane forces A ε, moments B ε)
+        eps = eps + shallow_shell.mean_strain(dbar, shallow_constants(edata, 3, 18), 3)
     N = Am @ eps
     out[:] = 0.0
     M = np.zeros(3)

@@ -25,16 +25,17 @@ import numpy as np
 
 from ..corotation import frame_quad as frame
 from ..corotation.transform import stiffness
+from ..elements import shallow_shell
 from ..elements import shell_quad as law
 from . import CCW
 from .spatial import (H, SYMMETRIZED, last_node_columns, nodal_states, pack_constants, perturb,
-                      rotation_vector_dofs, since_activation, symmetrize, unpack_constants)
+                      rotation_vector_dofs, shallow_constants, since_activation, symmetrize, unpack_constants)
 from .ufcx import lazy_kernels, tabulate_tensor_kernels
 
 NNODE = 4
 NDOF = 24
 NSTATE = 7
-NEDATA = 9 + 12 + 24 * 24  # R0, x̄0, K̄ (computed once per cell)
+NEDATA = 9 + 12 + 24 * 24 + shallow_shell.size(4)  # R0, x̄0, K̄, shallow-shell data (once per cell)
 NCOEF = NNODE * NSTATE + law.NPROPS + NEDATA
 _P0 = NNODE * NSTATE
 _E0 = _P0 + law.NPROPS
@@ -49,6 +50,7 @@ def element_data(X, props, out):
     K = np.empty((24, 24))
     law.local_stiffness(xbar0, props, K)
     pack_constants(R0, xbar0, K, out)
+    law.shallow_data(xbar0, props, out[9 + 12 + 24 * 24:])
 
 
 @numba.njit(cache=True)
@@ -80,10 +82,11 @@ def corotational_ccw(Xc, Sc, edata, f, K, tangent=True):
     u = np.empty((4, 3))
     R = np.empty((4, 3, 3))
     nodal_states(Sc, u, R)
+    sdata = shallow_constants(edata, 4, 24)
     if tangent:
-        frame.shell_force_and_tangent(Xc, u, R, R0, xbar0, Kbar, f, K)
+        frame.shell_force_and_tangent(Xc, u, R, R0, xbar0, Kbar, sdata, f, K)
     else:
-        frame.shell_force(Xc, u, R, R0, xbar0, Kbar, f)
+        frame.shell_force(Xc, u, R, R0, xbar0, Kbar, sdata, f)
 
 
 @numba.njit(cache=True)
@@ -94,7 +97,8 @@ def complex_step_ccw(Xc, Sc, edata, f, K):
     u = np.empty((4, 3))
     R = np.empty((4, 3, 3))
     nodal_states(Sc, u, R)
-    frame.shell_force(Xc, u, R, R0, xbar0, Kbar, f)
+    sdata = shallow_constants(edata, 4, 24)
+    frame.shell_force(Xc, u, R, R0, xbar0, Kbar, sdata, f)
     uc = u.astype(np.complex128)
     Rc = R.astype(np.complex128)
     up = np.empty_like(uc)
@@ -102,7 +106,7 @@ def complex_step_ccw(Xc, Sc, edata, f, K):
     fc = np.empty(24, dtype=np.complex128)
     for j in range(18):
         perturb(uc, Rc, j, up, Rp)
-        frame.shell_force(Xc, up, Rp, R0, xbar0, Kbar, fc)
+        frame.shell_force(Xc, up, Rp, R0, xbar0, Kbar, sdata, fc)
         for i in range(24):
             K[i, j] = fc[i].imag / H
     last_node_columns(f, Xc, u, K)
@@ -209,6 +213,10 @@ def resultants(X, S, props, large_rotations, out, axes):
         axes[:, :] = R0.T
     out[:] = 0.0
     law.centre_resultants(xbar0, props, dbar, out)
+    if large_rotations:  # the shallow-shell strain: N += A η̄, M += B η̄
+        eta = shallow_shell.mean_strain(dbar, shallow_constants(edata, 4, 24), 4)
+        out[0:3] += props[law.A0:law.A0 + 9].copy().reshape(3, 3) @ eta
+        out[3:6] += props[law.B0:law.B0 + 9].copy().reshape(3, 3) @ eta
     t = props[law.T]
     for side in range(2):
         z = 1.0 if side == 0 else -1.0

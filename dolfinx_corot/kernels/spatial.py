@@ -38,11 +38,12 @@ H = 1e-30  # complex step
 
 @numba.njit(cache=True)
 def pack_constants(R0, xbar0, Kbar, out):
-    """out (9 + 3n + m²,) = (R0 (3, 3), x̄0 (n, 3), K̄ (m, m)) flattened."""
+    """out[:9 + 3n + m²] = (R0 (3, 3), x̄0 (n, 3), K̄ (m, m)) flattened (a shell's shallow-shell
+    data follows, see :func:`shallow_constants`)."""
     e = 9 + xbar0.size
     out[:9] = R0.ravel()
     out[9:e] = xbar0.ravel()
-    out[e:] = Kbar.ravel()
+    out[e:e + Kbar.size] = Kbar.ravel()
 
 
 @numba.njit(cache=True)
@@ -50,7 +51,13 @@ def unpack_constants(edata, nnode, nbar):
     """(R0 (3, 3), x̄0 (nnode, 3), K̄ (nbar, nbar)) from the packed per-cell constants edata."""
     e = 9 + 3 * nnode
     return (edata[:9].copy().reshape(3, 3), edata[9:e].copy().reshape(nnode, 3),
-            edata[e:].copy().reshape(nbar, nbar))
+            edata[e:e + nbar * nbar].copy().reshape(nbar, nbar))
+
+
+@numba.njit(cache=True)
+def shallow_constants(edata, nnode, nbar):
+    """The shallow-shell data (:mod:`dolfinx_corot.elements.shallow_shell`) packed after K̄."""
+    return edata[9 + 3 * nnode + nbar * nbar:]
 
 
 @numba.njit(cache=True)

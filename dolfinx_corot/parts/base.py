@@ -706,7 +706,8 @@ class Part:
     def add_truss(self, where, area, material, prestress_force) -> PartRef:
         self._refuse_kind("truss", where, "bars need a mesh of lines")
 
-    def add_shell(self, where, section, drilling, membrane=None, kinematics="kirchhoff", axis=None) -> PartRef:
+    def add_shell(self, where, section, drilling, membrane=None, kinematics="kirchhoff", axis=None,
+                  shallow=False) -> PartRef:
         self._refuse_kind("shell", where, "shells need a triangle or quadrilateral mesh in 3D "
                           "(from_gmsh(model, gdim=3))")
 

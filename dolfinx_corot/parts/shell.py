@@ -408,7 +408,7 @@ class Shell3D(Surface3D):
         super().__init__(tmesh, large_rotations)
 
     def add_shell(self, where, section, drilling: float, membrane: str | None = None, kinematics: str = "kirchhoff",
-                  axis=None):
+                  axis=None, shallow: bool = False):
         label = f"shell '{where}'"
         if kinematics != "kirchhoff":
             raise ValueError(f"{label}: kinematics '{kinematics}': shell triangles bend as discrete Kirchhoff "
@@ -421,6 +421,7 @@ class Shell3D(Surface3D):
         E, nu = self._reference_modulus(section)
         head = np.zeros(shell_law.NPROPS)
         head[:6] = E, nu, section.thickness, drilling, 1.0, 1.0 if membrane == "opt" else 0.0
+        head[shell_law.SHALLOW] = 1.0 if shallow else 0.0
         rows = self._section_rows(head, section, axis, (shell_law.A0, shell_law.B0, shell_law.D0), True)
         return self._remember_section(self.add_elements(where, rows, True, "shell",
                                                         self._fingerprint(head, section, axis)), section, axis)
@@ -446,7 +447,7 @@ class ShellQuad(Surface3D):
     kernels = OnFirstUse("shell_quad")
 
     def add_shell(self, where, section, drilling: float, membrane: str | None = None, kinematics: str = "kirchhoff",
-                  axis=None):
+                  axis=None, shallow: bool = False):
         label = f"shell '{where}'"
         if kinematics not in ("kirchhoff", "mindlin"):
             raise ValueError(f"{label}: kinematics '{kinematics}' is not 'kirchhoff' (DKQ) or 'mindlin' (MITC4)")
@@ -459,6 +460,7 @@ class ShellQuad(Surface3D):
         head = np.zeros(quad_shell_law.NPROPS)
         head[:4] = E, nu, section.thickness, drilling
         head[quad_shell_law.KIRCHHOFF] = 1.0 if kinematics == "kirchhoff" else 0.0
+        head[quad_shell_law.SHALLOW] = 1.0 if shallow else 0.0
         slots = (quad_shell_law.A0, quad_shell_law.B0, quad_shell_law.D0, quad_shell_law.S0)
         rows = self._section_rows(head, section, axis, slots, True)
         return self._remember_section(self.add_elements(where, rows, True, "shell",
@@ -475,7 +477,8 @@ class MembraneQuad(Surface3D):
     membrane_A0 = quad_law.A0
     kernels = OnFirstUse("membrane_quad")
 
-    def add_shell(self, where, section, drilling, membrane=None, kinematics="kirchhoff", axis=None) -> PartRef:
+    def add_shell(self, where, section, drilling, membrane=None, kinematics="kirchhoff", axis=None,
+                  shallow=False) -> PartRef:
         raise ValueError(f"shell '{where}': this quadrilateral mesh was given membranes first, which made it a "
                          "part of membranes alone (bilinear Q4); add its shells before its membranes, so that "
                          "the mesh carries four-node shells and its membranes are the shell's membrane")

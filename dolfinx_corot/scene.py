@@ -201,8 +201,8 @@ class Scene:
         strain; :mod:`dolfinx_corot.elements.shallow_shell`): the membrane forces then act on the
         element's bending (initial-stress stiffness). It makes coarse meshes of shells that buckle
         or snap under compression far more accurate (docs/theory.md, "The shallow-shell local
-        law"); where coarse flat facets unbend a curved shell far (a cylinder pulled flat), it
-        stiffens them. A geometrically linear analysis ignores it.
+        law"); a shell pulled taut around a point load on coarse cells (the pull-out) comes out
+        stiffer with it. A geometrically linear analysis ignores it.
         """
         if not isinstance(shallow, (bool, np.bool_)):
             raise ValueError(f"shell '{where}': shallow = {shallow!r} must be True or False")

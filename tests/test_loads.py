@@ -439,12 +439,12 @@ def test_a_transverse_edge_load_on_a_cantilever_strip(kind, kinematics, exact):
 def test_edge_loads_on_the_lines_of_a_mixed_gmsh_surface(membrane):
     """A square read from gmsh as a triangle mesh (left half) and a quadrilateral mesh (right half)
     sharing their middle nodes, pulled by Nx on its physical lines x = 0 and x = 1 (one per part):
-    with CST triangles the uniaxial state exactly (1e-10). OPT triangles next to quadrilaterals
-    do not pass this patch test: their constant-stress state puts drilling moments ±α_b σ l²/12
-    on the ends of the edges they share with the quadrilaterals' linear edges, which cancel along
-    the interface but not where it meets the free edges (4 cells per half: the plate's middle
-    line stretches 1.1 % too much, and the quadrilaterals' corners are off by 18 % of the
-    stretch)."""
+    the uniaxial state exactly (1e-10), with CST and with OPT triangles. The OPT's constant-stress
+    state puts drilling moments ±α_b σ l²/12 on the ends of its edges (Allman's quadratic edge);
+    on the edges it shares with the quadrilaterals' linear edges they would cancel along the
+    interface but not where it meets the free edges (before the OPT kept those edges linear: the
+    plate's middle line stretched 1.1 % too much on 4 cells per half, the quadrilaterals'
+    corners were off by 18 % of the stretch)."""
     from gmsh_square import half_recombined_square
 
     t, E, nu = 0.01, 1e6, 0.3
@@ -463,18 +463,68 @@ def test_edge_loads_on_the_lines_of_a_mixed_gmsh_surface(membrane):
     sc.load(right_part, "x1", per_length=(1.0, 0.0, 0.0))
     dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
     strain = 1.0 / (E * t)
-    if membrane == "opt":
-        X, u = left_part.model.nodes()
-        left = u[np.argmin(np.hypot(X[:, 0], X[:, 1] - 0.5)), 0]
-        X, u = right_part.model.nodes()
-        right = u[np.argmin(np.hypot(X[:, 0] - 1.0, X[:, 1] - 0.5)), 0]
-        assert (right - left) / strain == pytest.approx(1.011, abs=2e-3)
-        assert np.abs(u[:, 0] - strain * X[:, 0]).max() / strain == pytest.approx(0.18, abs=0.01)
-        return
     for part in (left_part, right_part):
         X, u = part.model.nodes()
         np.testing.assert_allclose(u[:, 0], strain * X[:, 0], atol=1e-10 * strain)
         np.testing.assert_allclose(u[:, 1], -nu * strain * X[:, 1], atol=1e-10 * strain)
+
+
+@pytest.mark.parametrize("right", ["cst", "quad"])
+def test_opt_triangles_beside_linear_edges_pass_the_patch_test(right):
+    """The free plate of 8 × 8 squares: its left half OPT triangles, its right half on a second
+    mesh sharing the middle nodes — CST triangles or quadrilaterals — pulled by Nx = 1 on x = 0
+    and x = 1 (dead edge loads): the exact uniaxial state in both halves (1e-10). The OPT keeps
+    the edges it shares with them linear."""
+    t, E, nu, nx = 0.01, 1e6, 0.3, 8
+    X, Y = np.meshgrid(np.linspace(0, 1, nx + 1), np.linspace(0, 1, nx + 1), indexing="ij")
+    pts = np.c_[X.ravel(), Y.ravel(), np.zeros(X.size)]
+    idx = np.arange(X.size).reshape(nx + 1, nx + 1)
+    half = {}
+    for name, cols in (("left", slice(0, nx // 2)), ("right", slice(nx // 2, nx))):
+        i = idx[cols.start:cols.stop + 1, :]
+        a0, a1, b0, b1 = i[:-1, :-1].ravel(), i[1:, :-1].ravel(), i[:-1, 1:].ravel(), i[1:, 1:].ravel()
+        quads = name == "right" and right == "quad"
+        half[name] = np.c_[a0, a1, b1, b0] if quads else np.concatenate([np.c_[a0, a1, b1], np.c_[a0, b1, b0]])
+    groups = {"x0": idx[0, :], "x1": idx[-1, :], "corner": [idx[0, 0]], "foot": [idx[-1, 0]], "top": [idx[0, -1]]}
+    left = from_arrays(pts, half["left"], "plate", groups, comm=comm, node_source="split")
+    rightm = from_arrays(pts, half["right"], "plate", groups, comm=comm, node_source="split")
+    sc = dc.Scene(large_rotations=False)
+    lp = sc.add_shell(left, "plate", thickness=t, material=dc.Elastic(E, nu))
+    rp = sc.add_shell(rightm, "plate", thickness=t, material=dc.Elastic(E, nu),
+                      membrane="cst" if right == "cst" else None)
+    sc.fix(lp, "corner", dofs=("ux", "uy", "uz"))
+    sc.fix(lp, "top", dofs=("uz",))
+    sc.fix(rp, "foot", dofs=("uy", "uz"))
+    sc.load(lp, "x0", per_length=(-1.0, 0.0, 0.0))
+    sc.load(rp, "x1", per_length=(1.0, 0.0, 0.0))
+    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
+    strain = 1.0 / (E * t)
+    for part in (lp, rp):
+        Xn, u = part.model.nodes()
+        np.testing.assert_allclose(u[:, 0], strain * Xn[:, 0], atol=1e-10 * strain)
+        np.testing.assert_allclose(u[:, 1], -nu * strain * Xn[:, 1], atol=1e-10 * strain)
+
+
+def test_opt_and_cst_groups_of_one_mesh_pass_the_patch_test():
+    """One triangle mesh of 8 × 8 squares, its left half OPT and its right half CST (two cell
+    groups), pulled as above: the exact uniaxial state (1e-10)."""
+    t, E, nu = 0.01, 1e6, 0.3
+    tm = _free_plate(8, "triangle")
+    tm.add_cell_group("left_half", lambda x: x[0] < 0.5)
+    tm.add_cell_group("right_half", lambda x: x[0] > 0.5)
+    sc = dc.Scene(large_rotations=False)
+    p = sc.add_shell(tm, "left_half", thickness=t, material=dc.Elastic(E, nu))
+    q = sc.add_shell(tm, "right_half", thickness=t, material=dc.Elastic(E, nu), membrane="cst")
+    sc.fix(p, "corner", dofs=("ux", "uy", "uz"))
+    sc.fix(q, "x1", dofs=("uy", "uz"))
+    sc.fix(p, "y1", dofs=("uz",))
+    sc.load(p, "left", per_length=(-1.0, 0.0, 0.0))
+    sc.load(q, "right", per_length=(1.0, 0.0, 0.0))
+    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
+    strain = 1.0 / (E * t)
+    Xn, u = p.model.nodes()
+    np.testing.assert_allclose(u[:, 0], strain * Xn[:, 0], atol=1e-10 * strain)
+    np.testing.assert_allclose(u[:, 1], -nu * strain * Xn[:, 1], atol=1e-10 * strain)
 
 
 def test_bad_edge_loads_are_named():

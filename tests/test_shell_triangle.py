@@ -167,3 +167,20 @@ def test_opt_membrane_has_exactly_three_rigid_modes():
     # rigid in-plane rotation with θz = 1 at every node
     m = np.array([[-y, x, 1.0] for x, y in xy]).ravel()
     assert np.abs(K @ m).max() < 1e-10 * np.abs(K).max()
+
+
+def test_opt_with_linear_edges_keeps_its_rigid_modes_and_no_more():
+    """The OPT with one, two or all of its edges kept linear (beside quadrilaterals or CST
+    triangles): positive semi-definite with exactly the three in-plane rigid modes (a rigid turn
+    with θz equal to it costs nothing), and unchanged when no edge is flagged (1e-12)."""
+    xy = np.array([[0.0, 0.0], [1.2, 0.1], [0.3, 0.9]])
+    D = st.plane_stress(1.0, 0.3)
+    base = st.opt_membrane(xy, D, 0.3, 1.0)
+    np.testing.assert_allclose(st.opt_membrane_edges(xy, D, 0.3, 1.0, np.zeros(3)), base, atol=1e-14)
+    turn = np.array([[-y, x, 1.0] for x, y in xy]).ravel()
+    for flags in ([1, 0, 0], [0, 1, 1], [1, 1, 1]):
+        K = st.opt_membrane_edges(xy, D, 0.3, 1.0, np.array(flags, float))
+        w = np.linalg.eigvalsh(0.5 * (K + K.T))
+        assert w.min() > -1e-12 * w.max() and np.sum(w < 1e-10 * w.max()) == 3
+        assert np.abs(K @ turn).max() < 1e-12 * w.max()
+        assert np.abs(K - base).max() > 1e-3 * w.max()

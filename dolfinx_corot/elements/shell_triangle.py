@@ -107,6 +107,18 @@ def membrane_B(xy):
 def opt_membrane(xy, D, nu, t):
     """OPT membrane stiffness (9, 9) on (u, v, θz) of nodes 1–3 (counter-clockwise, local x–y),
     plane-stress stiffness D (3, 3) (the section's A/t), ν for β₀, thickness t."""
+    return opt_membrane_edges(xy, D, nu, t, np.zeros(3))
+
+
+@numba.njit(cache=True)
+def opt_membrane_edges(xy, D, nu, t, linear):
+    """:func:`opt_membrane` with the edges (1–2, 2–3, 3–1) where ``linear`` is nonzero kept
+    linear: the basic stiffness lumps no drilling moments there. The lumping matrix's drilling
+    rows are a sum over the edges (Felippa 2003, eq. 26): edge i → j adds
+    (α_b/6)(y_ji², x_ji², −2x_ji y_ji) to node j's row and subtracts it from node i's (before
+    the factor t/2), the moments ∓α_b t l² σ_nn/12 of Allman's quadratic edge; a linear
+    neighbour (a quadrilateral, a constant-strain triangle) has none, and with them the
+    interface passes the constant-stress patch test."""
     x1, y1, x2, y2, x3, y3 = xy[0, 0], xy[0, 1], xy[1, 0], xy[1, 1], xy[2, 0], xy[2, 1]
     x12, x21, x13, x31, x23, x32 = x1 - x2, x2 - x1, x1 - x3, x3 - x1, x2 - x3, x3 - x2
     y12, y21, y13, y31, y23, y32 = y1 - y2, y2 - y1, y1 - y3, y3 - y1, y2 - y3, y3 - y2
@@ -123,6 +135,17 @@ def opt_membrane(xy, D, nu, t):
     L[6, 0], L[6, 2] = y12, x21
     L[7, 1], L[7, 2] = x21, y12
     L[8, 0], L[8, 1], L[8, 2] = a6 * y12 * (y32 - y13), a6 * x21 * (x23 - x31), a3 * (x23 * y32 - x31 * y13)
+    for k in range(3):  # edges 1→2, 2→3, 3→1
+        if linear[k] != 0.0:
+            i, j = k, (k + 1) % 3
+            xji, yji = xy[j, 0] - xy[i, 0], xy[j, 1] - xy[i, 1]
+            e0, e1, e2 = a6 * yji * yji, a6 * xji * xji, -2.0 * a6 * xji * yji
+            L[3 * j + 2, 0] -= e0
+            L[3 * j + 2, 1] -= e1
+            L[3 * j + 2, 2] -= e2
+            L[3 * i + 2, 0] += e0
+            L[3 * i + 2, 1] += e1
+            L[3 * i + 2, 2] += e2
     L *= 0.5 * t
     K = np.empty((9, 9))
     _congruence(L, D, 1.0 / V, K)
@@ -341,6 +364,13 @@ def _add_btdb(B, D, w, dofs, K):
 @numba.njit(cache=True)
 def local_stiffness(xy, props, K):
     """Fill K (18, 18), the linear stiffness of the flat triangle with local node coordinates xy (3, 2)."""
+    local_stiffness_edges(xy, props, K, np.zeros(3))
+
+
+@numba.njit(cache=True)
+def local_stiffness_edges(xy, props, K, linear):
+    """:func:`local_stiffness` with the OPT's edges where ``linear`` (3,) is nonzero kept linear
+    (:func:`opt_membrane_edges`)."""
     t, alpha = props[T], props[ALPHA]
     Am = props[A0:A0 + 9].copy().reshape(3, 3)
     Bc = props[B0:B0 + 9].copy().reshape(3, 3)
@@ -350,7 +380,7 @@ def local_stiffness(xy, props, K):
     A = 0.5 * A2
     mem = np.array([0, 1, 6, 7, 12, 13])
     if props[BENDING] != 0.0 and props[OPT] != 0.0:
-        Km = opt_membrane(xy, Am / t, Am[0, 1] / Am[1, 1], t)
+        Km = opt_membrane_edges(xy, Am / t, Am[0, 1] / Am[1, 1], t, linear)
         mdofs = np.array([0, 1, 5, 6, 7, 11, 12, 13, 17])
         for a in range(9):
             for b in range(9):

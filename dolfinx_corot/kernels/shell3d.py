@@ -53,13 +53,13 @@ def _force(X, u, R, R0, xbar0, Kbar, sdata, f, rotations):
 
 
 @numba.njit(cache=True)
-def _setup(X, props):
+def _setup(X, props, linear):
     R0 = np.empty((3, 3))
     xbar0 = np.empty((3, 3))
     frame.initial(X, R0, xbar0)
     Kbar = np.empty((18, 18))
     xy = np.ascontiguousarray(xbar0[:, :2])
-    law.local_stiffness(xy, props, Kbar)
+    law.local_stiffness_edges(xy, props, Kbar, linear)
     sdata = np.empty(NSHALLOW)
     law.shallow_data(xy, props, sdata)
     return R0, xbar0, Kbar, sdata
@@ -69,17 +69,25 @@ def _setup(X, props):
 def element_data(X, props, out):
     """The constants of one element, out (NEDATA,) = (R0, x̄0, K̄, shallow-shell data) flattened
     (computed once per cell)."""
-    R0, xbar0, Kbar, sdata = _setup(X, props)
+    element_data_edges(X, props, np.zeros(3), out)
+
+
+@numba.njit(cache=True)
+def element_data_edges(X, props, linear, out):
+    """:func:`element_data` with the OPT's edges (1–2, 2–3, 3–1) where ``linear`` is nonzero
+    kept linear (:func:`dolfinx_corot.elements.shell_triangle.opt_membrane_edges`)."""
+    R0, xbar0, Kbar, sdata = _setup(X, props, linear)
     pack_constants(R0, xbar0, Kbar, out)
     out[9 + 9 + 18 * 18:] = sdata
 
 
 @numba.njit(cache=True)
-def element_data_all(X, props, active, out):
-    """element_data for every cell c with active[c]: X (n, 3, 3), props (n, NPROPS), out (n, NEDATA)."""
+def element_data_all(X, props, linear, active, out):
+    """element_data for every cell c with active[c]: X (n, 3, 3), props (n, NPROPS), linear
+    (n, 3) the edges kept linear (:func:`element_data_edges`), out (n, NEDATA)."""
     for c in range(X.shape[0]):
         if active[c]:
-            element_data(X[c], props[c], out[c])
+            element_data_edges(X[c], props[c], linear[c], out[c])
 
 
 @numba.njit(cache=True)
@@ -109,7 +117,7 @@ def corotational_cached(X, S, props, edata, f, K, tangent=True):
 @numba.njit(cache=True)
 def corotational_complex_step(X, S, props, f, K):
     """X (3, 3) initial nodes, S (3, 7) nodal states → f (18,), K (18, 18) (complex-step tangent)."""
-    R0, xbar0, Kbar, sdata = _setup(X, props)
+    R0, xbar0, Kbar, sdata = _setup(X, props, np.zeros(3))
     u = np.empty((3, 3))
     R = np.empty((3, 3, 3))
     nodal_states(S, u, R)

@@ -54,8 +54,9 @@ def element_data(X, props, out):
 
 
 @numba.njit(cache=True)
-def element_data_all(X, props, active, out):
-    """element_data for every active cell; X (n, 4, 3) in DOLFINx vertex order."""
+def element_data_all(X, props, linear, active, out):
+    """element_data for every active cell; X (n, 4, 3) in DOLFINx vertex order (linear: unused,
+    the triangles' signature: every edge of a quadrilateral is linear)."""
     Xc = np.empty((4, 3))
     for c in range(X.shape[0]):
         if active[c]:

@@ -1,6 +1,8 @@
 """Part models on several meshes solved as one system."""
 from __future__ import annotations
 
+import numpy as np
+
 
 class Coupled:
     """Structural models on several meshes, solved as one system (:class:`dolfinx_corot.assembly.CoupledSystem`).
@@ -17,6 +19,7 @@ class Coupled:
     def __init__(self, models: list):
         self.models = list(models)
         self.large_rotations = self.models[0].large_rotations
+        _link_surfaces(self.models)
 
     @property
     def comm(self):
@@ -65,3 +68,23 @@ class Coupled:
 
     def describe(self) -> list:
         return [m.describe() for m in self.models]
+
+
+def _link_surfaces(models: list) -> None:
+    """Tell each shell triangle part which of its edges border linear membrane edges on the
+    other meshes of its node source (quadrilaterals, constant-strain triangles, membranes): see
+    :meth:`dolfinx_corot.parts.shell.Shell3D._linear_edge_flags`. Collective."""
+    from .shell import Shell3D, Surface3D
+
+    surfaces = [m for m in models if isinstance(m, Surface3D)]
+    if not any(isinstance(m, Shell3D) for m in surfaces) or len(surfaces) < 2:
+        return
+    edges = {id(m): m.linear_edges() for m in surfaces}
+    for m in surfaces:
+        if isinstance(m, Shell3D):
+            others = [edges[id(o)] for o in surfaces
+                      if o is not m and o.tmesh.node_source == m.tmesh.node_source]
+            foreign = np.unique(np.concatenate(others)) if others else None
+            if m._forms is not None and not np.array_equal(foreign, m.foreign_linear_edges):
+                m._forms = None  # its element constants read the edges
+            m.foreign_linear_edges = foreign

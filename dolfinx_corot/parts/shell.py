@@ -84,9 +84,45 @@ class Surface3D(Rotations3D, LineFrame):
         X = X + self._activation_translations(np.arange(len(X)))
         props = self.cell_properties(np.arange(len(X)))
         out = np.zeros((len(X), n))
-        self.kernels.element_data_all(X, props, self._owner_of_cell != "", out)
+        self.kernels.element_data_all(X, props, self._linear_edge_flags(props), self._owner_of_cell != "", out)
         edata.x.array.reshape(-1, n)[Q.dofmap.list.array] = out
         return [edata]
+
+    # -- edges where a drilling membrane meets a linear one ---------------------------
+    # cell-local edges (as vertex pairs in DOLFINx's order) of triangles and quadrilaterals
+    _EDGES = {3: ((0, 1), (1, 2), (2, 0)), 4: ((0, 1), (1, 3), (3, 2), (2, 0))}
+    foreign_linear_edges: np.ndarray | None = None  # keys of other meshes' linear edges (set by Coupled)
+
+    def _cell_keys(self) -> np.ndarray:
+        """(cells, nodes) input (gmsh) node numbers of the local cells' vertices."""
+        mesh = self.tmesh.mesh
+        geo = np.asarray(mesh.geometry.input_global_indices, dtype=np.int64)
+        return geo[mesh.geometry.dofmap.array.reshape(-1, self.nodes_per_cell)]
+
+    def _edge_keys(self) -> np.ndarray:
+        """(cells, edges) a key per cell edge, the same in every mesh that shares the nodes."""
+        ids = self._cell_keys()
+        a = np.stack([ids[:, i] for i, _ in self._EDGES[self.nodes_per_cell]], axis=1)
+        b = np.stack([ids[:, j] for _, j in self._EDGES[self.nodes_per_cell]], axis=1)
+        return (np.minimum(a, b) << np.int64(32)) | np.maximum(a, b)
+
+    def _has_linear_edges(self, props: np.ndarray) -> np.ndarray:
+        """Per local cell: whether its element's membrane edges are linear (not the OPT's)."""
+        return self._cells_active()
+
+    def linear_edges(self) -> np.ndarray:
+        """Keys of the edges of this part's existing cells whose membrane edges are linear (all
+        ranks). Collective."""
+        cmap = self.tmesh.mesh.topology.index_map(2)
+        props = self.cell_properties(np.arange(cmap.size_local + cmap.num_ghosts))
+        mine = self._has_linear_edges(props)[: cmap.size_local]
+        keys = self._edge_keys()[: cmap.size_local][mine]
+        return np.unique(np.concatenate(self.comm.allgather(keys.ravel())))
+
+    def _linear_edge_flags(self, props: np.ndarray) -> np.ndarray:
+        """(cells, edges) 1 where a cell's edge is also an edge of a cell with a linear membrane
+        edge (see :class:`Shell3D`); zeros for parts without drilling membranes. Collective."""
+        return np.zeros((len(props), len(self._EDGES[self.nodes_per_cell])))
 
     def surface(self, where: str, body: str | None = None) -> Surface:
         """The shells or membranes of cell group ``where`` as a two-sided contact surface: their
@@ -425,6 +461,29 @@ class Shell3D(Surface3D):
         rows = self._section_rows(head, section, axis, (shell_law.A0, shell_law.B0, shell_law.D0), True)
         return self._remember_section(self.add_elements(where, rows, True, "shell",
                                                         self._fingerprint(head, section, axis)), section, axis)
+
+    def _has_linear_edges(self, props: np.ndarray) -> np.ndarray:
+        return self._cells_active() & ~((props[:, shell_law.BENDING] != 0.0) & (props[:, shell_law.OPT] != 0.0))
+
+    def _linear_edge_flags(self, props: np.ndarray) -> np.ndarray:
+        """(cells, 3) 1 on the edges (nodes 1–2, 2–3, 3–1) of OPT triangles that are also edges of
+        cells whose membrane edges are linear: constant-strain triangles, membranes and
+        quadrilaterals of this mesh or of meshes that share its nodes. The OPT lumps a constant
+        stress into drilling moments ∓α_b σ_nn l²/12 at an edge's ends (Allman's quadratic edge);
+        a linear neighbour lumps none, so the two do not pass the patch test together. On those
+        edges the OPT's edge stays linear (its basic stiffness without that edge's drilling
+        moments; Felippa 2003, eq. 26, edge by edge). Collective."""
+        opt = (props[:, shell_law.BENDING] != 0.0) & (props[:, shell_law.OPT] != 0.0)
+        anywhere = self.comm.allreduce(int(np.any(opt)), op=MPI.MAX)
+        flags = np.zeros((len(props), 3))
+        if not anywhere:
+            return flags
+        linear = self.linear_edges()
+        if self.foreign_linear_edges is not None:
+            linear = np.union1d(linear, self.foreign_linear_edges)
+        flags[:] = np.isin(self._edge_keys(), linear)
+        flags[~opt] = 0.0
+        return flags
 
     def _edge_drilling(self, cells: np.ndarray) -> np.ndarray:
         """α_b on OPT shells (the drilling part of their edges' displacement, Allman's), 0 on CST

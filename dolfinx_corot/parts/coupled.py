@@ -84,7 +84,4 @@ def _link_surfaces(models: list) -> None:
         if isinstance(m, Shell3D):
             others = [edges[id(o)] for o in surfaces
                       if o is not m and o.tmesh.node_source == m.tmesh.node_source]
-            foreign = np.unique(np.concatenate(others)) if others else None
-            if m._forms is not None and not np.array_equal(foreign, m.foreign_linear_edges):
-                m._forms = None  # its element constants read the edges
-            m.foreign_linear_edges = foreign
+            m.set_foreign_linear_edges(np.unique(np.concatenate(others)) if others else None)

@@ -93,6 +93,13 @@ class Surface3D(Rotations3D, LineFrame):
     _EDGES = {3: ((0, 1), (1, 2), (2, 0)), 4: ((0, 1), (1, 3), (3, 2), (2, 0))}
     foreign_linear_edges: np.ndarray | None = None  # keys of other meshes' linear edges (set by Coupled)
 
+    def set_foreign_linear_edges(self, keys: np.ndarray | None) -> None:
+        """The keys of the linear membrane edges of the other meshes that share this one's nodes
+        (see :meth:`Shell3D._linear_edge_flags`); forms made before are made again."""
+        if self._forms is not None and not np.array_equal(keys, self.foreign_linear_edges):
+            self._forms = None  # the element constants read the edges
+        self.foreign_linear_edges = keys
+
     def _cell_keys(self) -> np.ndarray:
         """(cells, nodes) input (gmsh) node numbers of the local cells' vertices."""
         mesh = self.tmesh.mesh

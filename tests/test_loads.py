@@ -435,6 +435,28 @@ def test_a_transverse_edge_load_on_a_cantilever_strip(kind, kinematics, exact):
     np.testing.assert_allclose(w / (q * b * L**3 / (3 * E * b * t**3 / 12)), 1.0, atol=exact)
 
 
+T_PLATE, E_PLATE, NU_PLATE = 0.01, 1e6, 0.3
+
+
+def _pull_two_halves(sc, left, right, groups=("corner", "top", "foot", "x0", "x1")):
+    """Hold the plate of ``left`` and ``right`` (PartRefs) against rigid motion (all translations at
+    the left's corner, u_z at its top, u_y and u_z at the right's foot), pull it by Nx = 1 on the
+    left's edge x = 0 and the right's x = 1 (dead edge loads), solve, and check the exact
+    uniaxial state in both (1e-10)."""
+    corner, top, foot, x0, x1 = groups
+    sc.fix(left, corner, dofs=("ux", "uy", "uz"))
+    sc.fix(left, top, dofs=("uz",))
+    sc.fix(right, foot, dofs=("uy", "uz"))
+    sc.load(left, x0, per_length=(-1.0, 0.0, 0.0))
+    sc.load(right, x1, per_length=(1.0, 0.0, 0.0))
+    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
+    strain = 1.0 / (E_PLATE * T_PLATE)
+    for part in (left, right):
+        X, u = part.model.nodes()
+        np.testing.assert_allclose(u[:, 0], strain * X[:, 0], atol=1e-10 * strain)
+        np.testing.assert_allclose(u[:, 1], -NU_PLATE * strain * X[:, 1], atol=1e-10 * strain)
+
+
 @pytest.mark.parametrize("membrane", ["cst", "opt"])
 def test_edge_loads_on_the_lines_of_a_mixed_gmsh_surface(membrane):
     """A square read from gmsh as a triangle mesh (left half) and a quadrilateral mesh (right half)
@@ -447,26 +469,16 @@ def test_edge_loads_on_the_lines_of_a_mixed_gmsh_surface(membrane):
     corners were off by 18 % of the stretch)."""
     from gmsh_square import half_recombined_square
 
-    t, E, nu = 0.01, 1e6, 0.3
     with half_recombined_square(comm, lambda i: 5, [("x0", [5]), ("x1", [2])]) as model:
         tri, quad = (dc.from_gmsh(model, 3, cells=shape) for shape in ("triangle", "quadrilateral"))
     sc = dc.Scene(large_rotations=False)
-    left_part = sc.add_shell(tri, "plate", thickness=t, material=dc.Elastic(E, nu), membrane=membrane)
-    right_part = sc.add_shell(quad, "plate", thickness=t, material=dc.Elastic(E, nu))
+    material = dc.Elastic(E_PLATE, NU_PLATE)
+    left_part = sc.add_shell(tri, "plate", thickness=T_PLATE, material=material, membrane=membrane)
+    right_part = sc.add_shell(quad, "plate", thickness=T_PLATE, material=material)
     tri.add_point_group("origin", [[0.0, 0.0, 0.0]])
     tri.add_point_group("top", [[0.0, 1.0, 0.0]])
     quad.add_point_group("foot", [[1.0, 0.0, 0.0]])
-    sc.fix(left_part, "origin", dofs=("ux", "uy", "uz"))
-    sc.fix(left_part, "top", dofs=("uz",))
-    sc.fix(right_part, "foot", dofs=("uy", "uz"))
-    sc.load(left_part, "x0", per_length=(-1.0, 0.0, 0.0))
-    sc.load(right_part, "x1", per_length=(1.0, 0.0, 0.0))
-    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
-    strain = 1.0 / (E * t)
-    for part in (left_part, right_part):
-        X, u = part.model.nodes()
-        np.testing.assert_allclose(u[:, 0], strain * X[:, 0], atol=1e-10 * strain)
-        np.testing.assert_allclose(u[:, 1], -nu * strain * X[:, 1], atol=1e-10 * strain)
+    _pull_two_halves(sc, left_part, right_part, ("origin", "top", "foot", "x0", "x1"))
 
 
 @pytest.mark.parametrize("right", ["cst", "quad"])
@@ -475,7 +487,7 @@ def test_opt_triangles_beside_linear_edges_pass_the_patch_test(right):
     mesh sharing the middle nodes — CST triangles or quadrilaterals — pulled by Nx = 1 on x = 0
     and x = 1 (dead edge loads): the exact uniaxial state in both halves (1e-10). The OPT keeps
     the edges it shares with them linear."""
-    t, E, nu, nx = 0.01, 1e6, 0.3, 8
+    nx = 8
     X, Y = np.meshgrid(np.linspace(0, 1, nx + 1), np.linspace(0, 1, nx + 1), indexing="ij")
     pts = np.c_[X.ravel(), Y.ravel(), np.zeros(X.size)]
     idx = np.arange(X.size).reshape(nx + 1, nx + 1)
@@ -489,42 +501,23 @@ def test_opt_triangles_beside_linear_edges_pass_the_patch_test(right):
     left = from_arrays(pts, half["left"], "plate", groups, comm=comm, node_source="split")
     rightm = from_arrays(pts, half["right"], "plate", groups, comm=comm, node_source="split")
     sc = dc.Scene(large_rotations=False)
-    lp = sc.add_shell(left, "plate", thickness=t, material=dc.Elastic(E, nu))
-    rp = sc.add_shell(rightm, "plate", thickness=t, material=dc.Elastic(E, nu),
-                      membrane="cst" if right == "cst" else None)
-    sc.fix(lp, "corner", dofs=("ux", "uy", "uz"))
-    sc.fix(lp, "top", dofs=("uz",))
-    sc.fix(rp, "foot", dofs=("uy", "uz"))
-    sc.load(lp, "x0", per_length=(-1.0, 0.0, 0.0))
-    sc.load(rp, "x1", per_length=(1.0, 0.0, 0.0))
-    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
-    strain = 1.0 / (E * t)
-    for part in (lp, rp):
-        Xn, u = part.model.nodes()
-        np.testing.assert_allclose(u[:, 0], strain * Xn[:, 0], atol=1e-10 * strain)
-        np.testing.assert_allclose(u[:, 1], -nu * strain * Xn[:, 1], atol=1e-10 * strain)
+    material = dc.Elastic(E_PLATE, NU_PLATE)
+    lp = sc.add_shell(left, "plate", thickness=T_PLATE, material=material)
+    rp = sc.add_shell(rightm, "plate", thickness=T_PLATE, material=material, membrane="cst" if right == "cst" else None)
+    _pull_two_halves(sc, lp, rp)
 
 
 def test_opt_and_cst_groups_of_one_mesh_pass_the_patch_test():
     """One triangle mesh of 8 × 8 squares, its left half OPT and its right half CST (two cell
     groups), pulled as above: the exact uniaxial state (1e-10)."""
-    t, E, nu = 0.01, 1e6, 0.3
     tm = _free_plate(8, "triangle")
     tm.add_cell_group("left_half", lambda x: x[0] < 0.5)
     tm.add_cell_group("right_half", lambda x: x[0] > 0.5)
     sc = dc.Scene(large_rotations=False)
-    p = sc.add_shell(tm, "left_half", thickness=t, material=dc.Elastic(E, nu))
-    q = sc.add_shell(tm, "right_half", thickness=t, material=dc.Elastic(E, nu), membrane="cst")
-    sc.fix(p, "corner", dofs=("ux", "uy", "uz"))
-    sc.fix(q, "x1", dofs=("uy", "uz"))
-    sc.fix(p, "y1", dofs=("uz",))
-    sc.load(p, "left", per_length=(-1.0, 0.0, 0.0))
-    sc.load(q, "right", per_length=(1.0, 0.0, 0.0))
-    dc.solve(sc, dc.LoadControl(steps=1), quiet=True)
-    strain = 1.0 / (E * t)
-    Xn, u = p.model.nodes()
-    np.testing.assert_allclose(u[:, 0], strain * Xn[:, 0], atol=1e-10 * strain)
-    np.testing.assert_allclose(u[:, 1], -nu * strain * Xn[:, 1], atol=1e-10 * strain)
+    material = dc.Elastic(E_PLATE, NU_PLATE)
+    p = sc.add_shell(tm, "left_half", thickness=T_PLATE, material=material)
+    q = sc.add_shell(tm, "right_half", thickness=T_PLATE, material=material, membrane="cst")
+    _pull_two_halves(sc, p, q, ("corner", "y1", "x1", "left", "right"))
 
 
 def test_bad_edge_loads_are_named():

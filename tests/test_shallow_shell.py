@@ -141,3 +141,16 @@ def test_bending_under_membrane_force_adds_the_initial_stress_work():
     m1 = f[4] + f[6 * 3 + 4]  # the moments of the end x = −l/2
     m_lin = (K @ d)[4] + (K @ d)[6 * 3 + 4]
     np.testing.assert_allclose(m1 - m_lin, N * l * b * (4 * th1 - th2) / 30, rtol=1e-10)
+
+
+def test_a_shallow_switch_that_is_not_a_boolean_is_refused():
+    """``add_shell(..., shallow=...)`` takes True or False; anything else is refused naming the
+    shells' group."""
+    import dolfinx_corot as dc
+    from dolfinx_corot.io.mesh import from_arrays
+
+    pts = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    tm = from_arrays(pts, np.array([[0, 1, 2]]), "plate")
+    sc = dc.Scene(large_rotations=True)
+    with pytest.raises(ValueError, match="shell 'plate': shallow = 'yes' must be True or False"):
+        sc.add_shell(tm, "plate", thickness=0.1, material=dc.Elastic(1.0, 0.3), shallow="yes")

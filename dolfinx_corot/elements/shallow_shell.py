@@ -97,8 +97,9 @@ def _eta(dbar, sdata, nnode):
 
 
 @numba.njit(cache=True)
-def force(dbar, Kbar, sdata, nnode, fbar):
-    """f̄ (n,) = ∂U/∂d̄ (the module's docstring), n = 6 nnode (real or complex)."""
+def _force(dbar, Kbar, sdata, nnode, fbar):
+    """Fill f̄ (n,) = ∂U/∂d̄ (real or complex); returns (active, η̄ (3,), H (3, nq), N (3,)) for
+    the tangent (H and N meaningless when not active)."""
     n = 6 * nnode
     nq = 3 * nnode
     for i in range(n):
@@ -109,23 +110,28 @@ def force(dbar, Kbar, sdata, nnode, fbar):
     g = 3 * nq * nq
     c = g + 3 * n
     area = sdata[c + 9]
+    N = np.zeros(3, dtype=dbar.dtype)
     if area == 0.0:
-        return
+        return False, N, np.zeros((3, nq), dtype=dbar.dtype), N
     eta, H = _eta(dbar, sdata, nnode)
-    N0 = np.zeros(3, dtype=dbar.dtype)
-    for k in range(3):
+    for k in range(3):  # N = C_N d̄ + A_m η̄
         acc = 0.0 * dbar[0]
         for j in range(n):
             acc += sdata[g + k * n + j] * dbar[j]
-        N0[k] = acc
-    N = N0.copy()
-    for k in range(3):
         for m in range(3):
-            N[k] += sdata[c + 3 * k + m] * eta[m]
+            acc += sdata[c + 3 * k + m] * eta[m]
+        N[k] = acc
     for j in range(n):
         fbar[j] += area * (sdata[g + j] * eta[0] + sdata[g + n + j] * eta[1] + sdata[g + 2 * n + j] * eta[2])
     for i in range(nq):
         fbar[_plate_dof(i)] += area * (H[0, i] * N[0] + H[1, i] * N[1] + H[2, i] * N[2])
+    return True, eta, H, N
+
+
+@numba.njit(cache=True)
+def force(dbar, Kbar, sdata, nnode, fbar):
+    """f̄ (n,) = ∂U/∂d̄ (the module's docstring), n = 6 nnode (real or complex)."""
+    _force(dbar, Kbar, sdata, nnode, fbar)
 
 
 @numba.njit(cache=True)
@@ -133,31 +139,20 @@ def force_and_tangent(dbar, Kbar, sdata, nnode, fbar, Kt):
     """f̄ (n,) and K̄_t = ∂f̄/∂d̄ (n, n) (real)."""
     n = 6 * nnode
     nq = 3 * nnode
-    force(dbar, Kbar, sdata, nnode, fbar)
+    active, eta, Hq, N = _force(dbar, Kbar, sdata, nnode, fbar)
     for i in range(n):
         for j in range(n):
             Kt[i, j] = Kbar[i, j]
+    if not active:
+        return
     g = 3 * nq * nq
     c = g + 3 * n
     area = sdata[c + 9]
-    if area == 0.0:
-        return
-    eta, Hq = _eta(dbar, sdata, nnode)
-    # H (3, n) on all dofs; N = C_N d̄ + A_m η̄
-    H = np.zeros((3, n))
+    H = np.zeros((3, n))  # H on all dofs
     for k in range(3):
         for i in range(nq):
             H[k, _plate_dof(i)] = Hq[k, i]
-    N = np.zeros(3)
-    for k in range(3):
-        acc = 0.0
-        for j in range(n):
-            acc += sdata[g + k * n + j] * dbar[j]
-        for m in range(3):
-            acc += sdata[c + 3 * k + m] * eta[m]
-        N[k] = acc
-    # C_N + A_m H
-    CA = np.empty((3, n))
+    CA = np.empty((3, n))  # C_N + A_m H
     for k in range(3):
         for j in range(n):
             acc = sdata[g + k * n + j]
@@ -188,6 +183,18 @@ def mean_strain(dbar, sdata, nnode):
         return np.zeros(3)
     eta, _ = _eta(dbar, sdata, nnode)
     return eta
+
+
+@numba.njit(cache=True)
+def interpolate_slopes(N, S):
+    """(2, nq): the slopes Σ_n N_n (βx, βy)_n at a point, from the shape functions N (m,) and the
+    slopes at the m interpolation nodes S (2m, nq) (rows βx, βy per node)."""
+    out = np.zeros((2, S.shape[1]))
+    for n in range(N.shape[0]):
+        for col in range(S.shape[1]):
+            out[0, col] += N[n] * S[2 * n, col]
+            out[1, col] += N[n] * S[2 * n + 1, col]
+    return out
 
 
 @numba.njit(cache=True)

@@ -128,6 +128,16 @@ class Part:
     kind_name = "part"
     followers: tuple = ()      # follower loads assembled as a contribution (structures)
     has_follower_loads = False  # follower loads in the part's own forms (solids)
+    reads_linear_edges = False  # its elements need the linear membrane edges of the meshes it shares nodes with
+
+    def linear_edges(self) -> np.ndarray | None:
+        """Keys (see :meth:`dolfinx_corot.parts.shell.Surface3D.linear_edges`) of the edges of this
+        part's cells whose membrane edges are linear; None for parts without membranes. Collective."""
+        return None
+
+    def set_foreign_linear_edges(self, keys: np.ndarray | None) -> None:
+        """The linear membrane edges of the other meshes that share this one's nodes (read by
+        parts whose :attr:`reads_linear_edges`)."""
 
     def _init_conditions(self) -> None:
         self.ndof = len(self.dof_names)

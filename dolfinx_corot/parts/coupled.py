@@ -71,17 +71,15 @@ class Coupled:
 
 
 def _link_surfaces(models: list) -> None:
-    """Tell each shell triangle part which of its edges border linear membrane edges on the
-    other meshes of its node source (quadrilaterals, constant-strain triangles, membranes): see
-    :meth:`dolfinx_corot.parts.shell.Shell3D._linear_edge_flags`. Collective."""
-    from .shell import Shell3D, Surface3D
-
-    surfaces = [m for m in models if isinstance(m, Surface3D)]
-    if not any(isinstance(m, Shell3D) for m in surfaces) or len(surfaces) < 2:
+    """Hand each part that reads them (shell triangles with drilling membranes) the linear
+    membrane edges of the other meshes of its node source (quadrilaterals, constant-strain
+    triangles, membranes): see :meth:`dolfinx_corot.parts.shell.Shell3D._linear_edge_flags`.
+    Collective."""
+    if not any(m.reads_linear_edges for m in models):
         return
-    edges = {id(m): m.linear_edges() for m in surfaces}
-    for m in surfaces:
-        if isinstance(m, Shell3D):
-            others = [edges[id(o)] for o in surfaces
-                      if o is not m and o.tmesh.node_source == m.tmesh.node_source]
+    edges = [m.linear_edges() for m in models]
+    for m in models:
+        if m.reads_linear_edges:
+            others = [e for o, e in zip(models, edges)
+                      if o is not m and e is not None and o.tmesh.node_source == m.tmesh.node_source]
             m.set_foreign_linear_edges(np.unique(np.concatenate(others)) if others else None)

@@ -440,6 +440,7 @@ class Shell3D(Surface3D):
 
     nodes_per_cell = 3
     nprops = shell_law.NPROPS
+    reads_linear_edges = True  # the OPT keeps its edges beside linear ones linear
     membrane_A0 = shell_law.A0
     section_slots = (shell_law.A0, shell_law.B0, shell_law.D0)
     kernels = OnFirstUse("shell3d")

@@ -136,13 +136,19 @@ class DenseFactor:
         self.negative = 0
         self.sign = 1
         self.null_pivots = 0
+        self._flat: tuple | None = None
 
     def _dense(self) -> np.ndarray:
         """The matrix scaled to a unit diagonal, S K S (as MUMPS scales: pivots compare with 1;
         congruence keeps the inertia and the determinant's sign); sets S."""
         indptr, indices, values = self.A.getValuesCSR()
+        if self._flat is None or self._flat[0].shape != indptr.shape or not (
+                np.array_equal(self._flat[0], indptr) and np.array_equal(self._flat[1], indices)):
+            # positions of the stored entries in the dense array, kept while the sparsity is
+            rows = np.repeat(np.arange(self.n), np.diff(indptr))
+            self._flat = (indptr.copy(), indices.copy(), rows * self.n + indices)
         K = np.zeros((self.n, self.n))
-        K[np.repeat(np.arange(self.n), np.diff(indptr)), indices] = values
+        K.ravel()[self._flat[2]] = values
         diag = np.abs(np.diag(K))
         self._s = 1.0 / np.sqrt(np.where(diag > 0.0, diag, 1.0))
         K *= self._s[:, None]

@@ -32,12 +32,13 @@ is the spin of the element frame in its own axes,
 :math:`\mathbf f = \mathbf B^T\bar{\mathbf f}`.
 
 The rotation algebra (exp, log, T⁻¹) is that of :mod:`dolfinx_corot.rotations`.
-Every function here is complex-analytic in the configuration, so that the
-consistent tangent :math:`\mathbf K = \partial\mathbf f/\partial\mathbf d` (material and
-geometric parts, i.e. :math:`\mathbf B^T\bar{\mathbf K}\mathbf B + \partial\mathbf B^T/\partial\mathbf d:\bar{\mathbf f}`)
-is obtained exactly to rounding by complex-step differentiation
-(Squire & Trapp 1998) in :mod:`dolfinx_corot.kernels.beam3d`. Branches test
-real parts only.
+The consistent tangent :math:`\mathbf K = \partial\mathbf f/\partial\mathbf d
+= \mathbf B^T\bar{\mathbf K}\mathbf B + \partial\mathbf B^T/\partial\mathbf d:\bar{\mathbf f}`
+is in closed form (:func:`add_geometric_stiffness`): the geometric part of Battini & Pacoste
+(2002) with the variations of every entry of :math:`\mathbf G^T` kept, so that it equals the
+complex-step derivative of the force (Squire & Trapp 1998) to rounding, which the tests check.
+Every function is complex-analytic in the configuration (branches test real parts only), so
+that the complex-step derivative stays available as that check.
 """
 from __future__ import annotations
 
@@ -45,7 +46,9 @@ import numba
 import numpy as np
 
 from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
-from .transform import rotate_columns
+from .transform import rotate_columns, subtract_spin_g_omega
+
+_H = 1e-30  # complex step of the 3 × 3 operator T⁻ᵀ(θ) m̄
 
 
 @numba.njit(cache=True)
@@ -103,9 +106,20 @@ def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
     rotations; R0: initial element frame. Fills th1, th2 (3,) and B; returns ū.
     """
     dt = u1.dtype
+    Rr = np.empty((3, 3), dtype=dt)
     p1 = np.empty(3, dtype=dt)
     p2 = np.empty(3, dtype=dt)
-    Rr = np.empty((3, 3), dtype=dt)
+    GT = np.empty((3, 12), dtype=dt)
+    Ti = np.empty((2, 3, 3), dtype=dt)
+    ubar, _ = frame_and_basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B, Rr, p1, p2, GT, Ti)
+    return ubar
+
+
+@numba.njit(cache=True)
+def frame_and_basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B, Rr, p1, p2, GT, Ti):
+    """:func:`basic`, also filling what the tangent reuses: the frame Rr (3, 3), p1, p2 (3,),
+    Gᵀ (3, 12) in local components and T⁻¹(θ̄_i) (2, 3, 3); returns (ū, l)."""
+    dt = u1.dtype
     l = current_frame(X1, X2, u1, u2, R1, R2, R0, Rr, p1, p2)
     p = 0.5 * (p1 + p2)
     e1 = Rr[:, 0].copy()
@@ -127,7 +141,7 @@ def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
     pl0 = dot(e1, p)
     pl1 = dot(e2, p)
     eta = pl0 / pl1
-    GT = np.zeros((3, 12), dtype=dt)
+    GT[:, :] = 0.0
     GT[0, 2] = eta / l
     GT[0, 3] = 0.5 * dot(e2, p1) / pl1
     GT[0, 4] = -0.5 * dot(e1, p1) / pl1
@@ -142,13 +156,143 @@ def basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B):
     Bl = np.zeros((7, 12), dtype=dt)
     Bl[0, 0] = -1.0
     Bl[0, 6] = 1.0
-    Ti = np.empty((3, 3), dtype=dt)
     for i in range(2):
-        tangent_inv_so3(th1 if i == 0 else th2, Ti)
+        tangent_inv_so3(th1 if i == 0 else th2, Ti[i])
         for r in range(3):
             for c in range(12):
-                Bl[1 + 3 * i + r, c] = -(Ti[r, 0] * GT[0, c] + Ti[r, 1] * GT[1, c] + Ti[r, 2] * GT[2, c])
+                Bl[1 + 3 * i + r, c] = -(Ti[i, r, 0] * GT[0, c] + Ti[i, r, 1] * GT[1, c] + Ti[i, r, 2] * GT[2, c])
             for k in range(3):
-                Bl[1 + 3 * i + r, 3 + 6 * i + k] += Ti[r, k]
+                Bl[1 + 3 * i + r, 3 + 6 * i + k] += Ti[i, r, k]
     rotate_columns(Bl, Rr, B, 7, 12)
-    return ubar
+    return ubar, l
+
+
+@numba.njit(cache=True, inline="always")
+def _grad_dot(a, da, b, db, out):
+    """out (12,) = ∇(a·b) = aᵀ∇b + bᵀ∇a for a, b (3,) with gradients da, db (3, 12)."""
+    for j in range(12):
+        out[j] = (a[0] * db[0, j] + a[1] * db[1, j] + a[2] * db[2, j]
+                  + b[0] * da[0, j] + b[1] * da[1, j] + b[2] * da[2, j])
+
+
+@numba.njit(cache=True)
+def add_geometric_stiffness(l, Rr, p1, p2, GT, Ti, th1, th2, B, fbar, K):
+    r"""K (12, 12) += ∂Bᵀ/∂d : f̄, the geometric part of the consistent tangent, in closed form.
+
+    With m_i = T⁻ᵀ(θ̄_i) m̄_i and f_l = Σ_i (S_iᵀ − G) m_i the local rotational forces, the force is
+    f = N r + E f_l, r = (−e₁, 0, e₁, 0); at fixed f̄ its variation has four parts:
+
+    * N δr, δe₁ = ω × e₁;
+    * E Σ_i (S_iᵀ − G) H_i δθ̄_i, H_i = ∂(T⁻ᵀ(θ) m̄_i)/∂θ at θ̄_i (Battini & Pacoste 2002's K_h;
+      by a complex step on the 3 × 3 operator, exact to rounding);
+    * δE f_l = −E S(f_l) Ω δd, the frame's spin ω = R_r Ω δd, Ω = Gᵀ Eᵀ;
+    * −E δG m, m = m₁ + m₂: the gradients of Gᵀ's entries η/l, p_i·e₂/(p·e₂), p_i·e₁/(p·e₂), 1/l
+      through δe_k = ω × e_k, δp_i = δw_i × p_i and δl = r·δd.
+
+    Arguments from :func:`frame_and_basic` and the basic forces f̄ (7,); every term is exact, so
+    K equals the complex-step derivative of f = Bᵀ f̄ to rounding (tested)."""
+    m = np.empty((2, 3))
+    for i in range(2):
+        for r in range(3):
+            m[i, r] = Ti[i, 0, r] * fbar[1 + 3 * i] + Ti[i, 1, r] * fbar[2 + 3 * i] + Ti[i, 2, r] * fbar[3 + 3 * i]
+    ms = np.empty(3)
+    for r in range(3):
+        ms[r] = m[0, r] + m[1, r]
+    fl = np.empty(12)
+    for c in range(12):
+        fl[c] = -(GT[0, c] * ms[0] + GT[1, c] * ms[1] + GT[2, c] * ms[2])
+    for k in range(3):
+        fl[3 + k] += m[0, k]
+        fl[9 + k] += m[1, k]
+    Om = np.empty((3, 12))
+    rotate_columns(GT, Rr, Om, 3, 12)
+    Wg = np.empty((3, 12))  # the frame's spin in global components per unit δd
+    for k in range(3):
+        for j in range(12):
+            Wg[k, j] = Rr[k, 0] * Om[0, j] + Rr[k, 1] * Om[1, j] + Rr[k, 2] * Om[2, j]
+    Z = np.zeros((12, 12))  # in local components, rotated to global rows at the end
+    # K_h: (S_iᵀ − G) H_i B_θi
+    HBs = np.zeros((3, 12))
+    Hi = np.empty((3, 3))
+    Tc = np.empty((3, 3), dtype=np.complex128)
+    thc = np.empty(3, dtype=np.complex128)
+    for i in range(2):
+        th = th1 if i == 0 else th2
+        for k in range(3):
+            for a in range(3):
+                thc[a] = th[a]
+            thc[k] += 1j * _H
+            tangent_inv_so3(thc, Tc)
+            for r in range(3):
+                Hi[r, k] = (Tc[0, r] * fbar[1 + 3 * i] + Tc[1, r] * fbar[2 + 3 * i] + Tc[2, r] * fbar[3 + 3 * i]).imag / _H
+        for r in range(3):
+            for j in range(12):
+                v = Hi[r, 0] * B[1 + 3 * i, j] + Hi[r, 1] * B[2 + 3 * i, j] + Hi[r, 2] * B[3 + 3 * i, j]
+                Z[3 + 6 * i + r, j] += v
+                HBs[r, j] += v
+    for c in range(12):
+        g0, g1, g2 = GT[0, c], GT[1, c], GT[2, c]
+        if g0 != 0.0 or g1 != 0.0 or g2 != 0.0:
+            for j in range(12):
+                Z[c, j] -= g0 * HBs[0, j] + g1 * HBs[1, j] + g2 * HBs[2, j]
+    # δE f_l
+    subtract_spin_g_omega(Z, fl, Om, 12)
+    # −δG m: gradients of e1, e2 (ω × e_k), p_i (δw_i × p_i), l
+    e1 = Rr[:, 0].copy()
+    e2 = Rr[:, 1].copy()
+    de1 = np.empty((3, 12))
+    de2 = np.empty((3, 12))
+    for j in range(12):
+        for e, de in ((e1, de1), (e2, de2)):
+            de[0, j] = Wg[1, j] * e[2] - Wg[2, j] * e[1]
+            de[1, j] = Wg[2, j] * e[0] - Wg[0, j] * e[2]
+            de[2, j] = Wg[0, j] * e[1] - Wg[1, j] * e[0]
+    dp1 = np.zeros((3, 12))
+    dp2 = np.zeros((3, 12))
+    for pi, dpi, c0 in ((p1, dp1, 3), (p2, dp2, 9)):
+        # δw × p_i: column c0 + k is e_k × p_i
+        dpi[1, c0] = -pi[2]
+        dpi[2, c0] = pi[1]
+        dpi[0, c0 + 1] = pi[2]
+        dpi[2, c0 + 1] = -pi[0]
+        dpi[0, c0 + 2] = -pi[1]
+        dpi[1, c0 + 2] = pi[0]
+    p = 0.5 * (p1 + p2)
+    dp = 0.5 * (dp1 + dp2)
+    P = dot(p, e2)
+    Q = dot(p, e1)
+    dP = np.empty(12)
+    dQ = np.empty(12)
+    _grad_dot(p, dp, e2, de2, dP)
+    _grad_dot(p, dp, e1, de1, dQ)
+    dinvl = np.zeros(12)  # ∇(1/l) = −r/l²
+    for k in range(3):
+        dinvl[k] = e1[k] / (l * l)
+        dinvl[6 + k] = -e1[k] / (l * l)
+    ds = np.empty(12)
+    dt_ = np.empty(12)
+    for j in range(12):
+        da0 = dQ[j] / (P * l) - Q / (P * P * l) * dP[j] + Q / P * dinvl[j]
+        row2 = ms[0] * da0 + ms[1] * dinvl[j]
+        Z[2, j] -= row2
+        Z[8, j] += row2
+        Z[1, j] += ms[2] * dinvl[j]
+        Z[7, j] -= ms[2] * dinvl[j]
+    for pi, dpi, c0 in ((p1, dp1, 3), (p2, dp2, 9)):
+        s = dot(pi, e2)
+        t = dot(pi, e1)
+        _grad_dot(pi, dpi, e2, de2, ds)
+        _grad_dot(pi, dpi, e1, de1, dt_)
+        for j in range(12):
+            Z[c0, j] -= ms[0] * (0.5 * ds[j] / P - 0.5 * s / (P * P) * dP[j])
+            Z[c0 + 1, j] -= ms[0] * (-0.5 * dt_[j] / P + 0.5 * t / (P * P) * dP[j])
+    # rows to global, then N δr
+    for b in range(4):
+        for k in range(3):
+            for j in range(12):
+                K[3 * b + k, j] += Rr[k, 0] * Z[3 * b, j] + Rr[k, 1] * Z[3 * b + 1, j] + Rr[k, 2] * Z[3 * b + 2, j]
+    N = fbar[0]
+    for k in range(3):
+        for j in range(12):
+            K[k, j] -= N * de1[k, j]
+            K[6 + k, j] += N * de1[k, j]

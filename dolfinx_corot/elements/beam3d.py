@@ -79,6 +79,34 @@ def basic_stiffness_linear(l0, props, kbar):
         kbar[4 + a, 1 + a] = k * (2.0 - phi)
 
 
+
+@numba.njit(cache=True)
+def basic_stiffness(l0, ubar, th1, th2, props, shallow_arch, kbar):
+    """kbar (7, 7) = ∂f̄/∂d̄ of :func:`basic_force`: the linear law, and with the shallow-arch
+    strain EA l₀ g gᵀ + n l₀ ∂g/∂d̄ in place of EA/l₀ (g = ∂ε̄/∂d̄, n the axial force)."""
+    basic_stiffness_linear(l0, props, kbar)
+    ea, eiy, eiz = props[EA], props[EIY], props[EIZ]
+    if not (shallow_arch and (eiy > 0.0 or eiz > 0.0)):
+        return
+    g = np.zeros(7)
+    g[0] = 1.0 / l0
+    eps = ubar / l0
+    for a in (1, 2):
+        g[1 + a] = (4.0 * th1[a] - th2[a]) / 30.0
+        g[4 + a] = (4.0 * th2[a] - th1[a]) / 30.0
+        eps += (2.0 * th1[a] * th1[a] - th1[a] * th2[a] + 2.0 * th2[a] * th2[a]) / 30.0
+    n = ea * eps + props[N0]
+    kbar[0, 0] = 0.0
+    for i in range(7):
+        for j in range(7):
+            kbar[i, j] += ea * l0 * g[i] * g[j]
+    for a in (1, 2):
+        kbar[1 + a, 1 + a] += n * l0 * 4.0 / 30.0
+        kbar[4 + a, 4 + a] += n * l0 * 4.0 / 30.0
+        kbar[1 + a, 4 + a] -= n * l0 / 30.0
+        kbar[4 + a, 1 + a] -= n * l0 / 30.0
+
+
 def check_props(values: dict, where: str) -> None:
     """Raise ValueError naming ``where`` for non-physical section properties."""
     for name, v in values.items():

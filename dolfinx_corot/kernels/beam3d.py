@@ -5,10 +5,11 @@ nodal rotation; element vector (12): (u₁, w₁, u₂, w₂) with spatial spins
 
 * :func:`corotational`: f = Bᵀ f̄ from :mod:`dolfinx_corot.corotation.frame3d`
   and :mod:`dolfinx_corot.elements.beam3d`; the consistent tangent
-  K = ∂f/∂d (both Bᵀ K̄ B and ∂Bᵀ/∂d : f̄) by complex-step differentiation
-  (:func:`dolfinx_corot.kernels.spatial.perturb`), exact to rounding. Only
-  the six columns of node 1 are differentiated; those of node 2 follow
-  exactly from translation and rotation invariance of f.
+  K = ∂f/∂d = Bᵀ K̄ B + ∂Bᵀ/∂d : f̄ in closed form
+  (:func:`~dolfinx_corot.corotation.frame3d.add_geometric_stiffness`), 5.9 µs an element
+  against 23 µs for its complex-step derivative, :func:`corotational_complex_step`
+  (:func:`dolfinx_corot.kernels.spatial.perturb`; the six columns of node 1 differentiated,
+  those of node 2 from translation and rotation invariance of f), which the tests compare it to.
 * :func:`linear`: K = B₀ᵀ K̄ B₀ in the initial frame, f = K d with the nodal
   rotation vectors log(R_i) (no co-rotational work).
 
@@ -17,7 +18,7 @@ DOLFINx kernels (:data:`vector_kernel`, :data:`matrix_kernel`, from
 [state node 1 (7), state node 2 (7), props (NPROPS)], ``c`` =
 [mode: 0 linear, 1 co-rotational, 2 co-rotational with the symmetric part of the
 tangent], ``coords`` (2, 3). The residual of a co-rotational
-analysis needs the force only: no complex-step columns.
+analysis needs the force only.
 """
 from __future__ import annotations
 
@@ -51,15 +52,44 @@ def _force(X1, X2, u1, u2, R1, R2, R0, l0, props, f):
 
 @numba.njit(cache=True)
 def _corotational(X, S, props, f, K, tangent):
-    """:func:`corotational` on the element's X (2, 3) and S (2, 7); K only if tangent."""
+    """:func:`corotational` on the element's X (2, 3) and S (2, 7); K only if tangent: the closed
+    form Bᵀ K̄ B + ∂Bᵀ/∂d : f̄ (:func:`~dolfinx_corot.corotation.frame3d.add_geometric_stiffness`)."""
+    R0 = np.empty((3, 3))
+    l0 = frame3d.initial_frame(X[0], X[1], props[law.VX:law.VZ + 1], R0)
+    u = np.empty((2, 3))
+    R = np.empty((2, 3, 3))
+    nodal_states(S, u, R)
+    th1 = np.empty(3)
+    th2 = np.empty(3)
+    B = np.empty((7, 12))
+    Rr = np.empty((3, 3))
+    p1 = np.empty(3)
+    p2 = np.empty(3)
+    GT = np.empty((3, 12))
+    Ti = np.empty((2, 3, 3))
+    ubar, l = frame3d.frame_and_basic(X[0], X[1], u[0], u[1], R[0], R[1], R0, l0, th1, th2, B, Rr, p1, p2, GT, Ti)
+    fbar = np.empty(7)
+    law.basic_force(l0, ubar, th1, th2, props, True, fbar)
+    force(B, fbar, f, 7, 12)
+    if not tangent:
+        return
+    kbar = np.empty((7, 7))
+    law.basic_stiffness(l0, ubar, th1, th2, props, True, kbar)
+    stiffness(B, kbar, K, 7, 12)
+    frame3d.add_geometric_stiffness(l, Rr, p1, p2, GT, Ti, th1, th2, B, fbar, K)
+
+
+@numba.njit(cache=True)
+def corotational_complex_step(X1, X2, s1, s2, props, f, K):
+    """:func:`corotational` with K by complex-step differentiation of f (the closed form's check):
+    the six columns of node 1 by complex steps, those of node 2 from invariance."""
+    X, S = _element(X1, X2, s1, s2)
     R0 = np.empty((3, 3))
     l0 = frame3d.initial_frame(X[0], X[1], props[law.VX:law.VZ + 1], R0)
     u = np.empty((2, 3))
     R = np.empty((2, 3, 3))
     nodal_states(S, u, R)
     _force(X[0], X[1], u[0], u[1], R[0], R[1], R0, l0, props, f)
-    if not tangent:
-        return
     uc = u.astype(np.complex128)
     Rc = R.astype(np.complex128)
     up = np.empty_like(uc)

@@ -289,6 +289,55 @@ def tangent_inv_so3(w, out=None):
 
 
 @numba.njit(cache=True)
+def tangent_inv_so3_derivative(th, m, out):
+    """out (3, 3) = ∂(T⁻ᵀ(θ) m)/∂θ for θ, m (3,) (real), T⁻¹ of :func:`tangent_inv_so3`: the
+    derivative co-rotational tangents contract with a nodal moment (Battini & Pacoste 2002's K_h).
+
+    T⁻ᵀ(θ) m = m + ½ θ × m + c θ × (θ × m), c(s) = (1 − h cot h)/s, s = |θ|², h = |θ|/2, so
+    out = −½ S(m) + c((θ·m) I + θ mᵀ − 2 m θᵀ) + 2c′(s) (θ × (θ × m)) θᵀ, with
+    c′(s) = −(cot h − h/sin²h)/(32h³) − c/s, or, for s < 10⁻² (where that cancels), c and c′ from
+    their Bernoulli series c = Σ_k |B₂ₖ| s^(k−1)/(2k)!. Tested against
+    :func:`tangent_inv_so3_derivative_complex_step`."""
+    s = th[0] * th[0] + th[1] * th[1] + th[2] * th[2]
+    if s < 1e-2:
+        c = 1.0 / 12.0 + s * (1.0 / 720.0 + s * (1.0 / 30240.0 + s * (1.0 / 1209600.0 + s / 47900160.0)))
+        dc = 1.0 / 720.0 + s * (2.0 / 30240.0 + s * (3.0 / 1209600.0 + s * 4.0 / 47900160.0))
+    else:
+        h = 0.5 * np.sqrt(s)
+        sn = np.sin(h)
+        cot = np.cos(h) / sn
+        c = (1.0 - h * cot) / s
+        dc = -(cot - h / (sn * sn)) / (32.0 * h * h * h) - c / s
+    tm = th[0] * m[0] + th[1] * m[1] + th[2] * m[2]
+    for a in range(3):
+        wa = th[a] * tm - m[a] * s  # (θ × (θ × m))_a
+        for b in range(3):
+            out[a, b] = c * (th[a] * m[b] - 2.0 * m[a] * th[b]) + 2.0 * dc * wa * th[b]
+        out[a, a] += c * tm
+    out[0, 1] += 0.5 * m[2]
+    out[0, 2] -= 0.5 * m[1]
+    out[1, 0] -= 0.5 * m[2]
+    out[1, 2] += 0.5 * m[0]
+    out[2, 0] += 0.5 * m[1]
+    out[2, 1] -= 0.5 * m[0]
+
+
+@numba.njit(cache=True)
+def tangent_inv_so3_derivative_complex_step(th, m, out):
+    """:func:`tangent_inv_so3_derivative` by complex-step differentiation (its test's reference)."""
+    h = 1e-30
+    thc = np.empty(3, dtype=np.complex128)
+    Tc = np.empty((3, 3), dtype=np.complex128)
+    for j in range(3):
+        for k in range(3):
+            thc[k] = th[k]
+        thc[j] += 1j * h
+        tangent_inv_so3(thc, Tc)
+        for i in range(3):
+            out[i, j] = (Tc[0, i] * m[0] + Tc[1, i] * m[1] + Tc[2, i] * m[2]).imag / h
+
+
+@numba.njit(cache=True)
 def compose(R1, R2):
     """Composition R1·R2 (3, 3): first R2, then R1."""
     return R1 @ R2

@@ -75,27 +75,6 @@ def test_tangent_matches_finite_differences(kind, large):
         assert err < 1e-6, (kind, large, err)
 
 
-@pytest.mark.parametrize("angle", [0.0, 1e-4, 0.0999, 0.1001, 1.0, 3.0, 6.0])
-def test_derivative_of_the_inverse_tangent_operator(angle):
-    """∂(T⁻ᵀ(θ) m)/∂θ (the K_h block) against the complex-step derivative of T⁻¹ (1e-13), on both
-    sides of its series switch at |θ| = 0.1 and up to 6 rad."""
-    from dolfinx_corot.corotation.frame3d import d_inverse_tangent_transpose
-
-    rng = np.random.default_rng(5)
-    for _ in range(5):
-        axis = rng.normal(size=3)
-        th = angle * axis / np.linalg.norm(axis)
-        m = rng.normal(size=3)
-        H = np.empty((3, 3))
-        d_inverse_tangent_transpose(th, m, H)
-        Hc = np.empty((3, 3))
-        for j in range(3):
-            tc = th.astype(complex)
-            tc[j] += 1e-30j
-            Hc[:, j] = (rot.tangent_inv_so3(tc).T @ m).imag / 1e-30
-        assert np.abs(H - Hc).max() <= 1e-13 * np.abs(Hc).max()
-
-
 @pytest.mark.parametrize("kind", list(PROPS))
 @pytest.mark.parametrize("scale", [0.0, 0.3, 3.0])
 def test_closed_form_tangent_equals_the_complex_step_derivative(kind, scale):

@@ -52,23 +52,6 @@ def test_closed_form_tangent_equals_complex_step_tangent(kind):
         assert np.abs(K1 - K2).max() < 1e-10 * np.abs(K2).max()
 
 
-def test_derivative_of_the_inverse_tangent_map_in_closed_form():
-    """∂(T⁻¹(θ)ᵀm)/∂θ (the moment term of the shell's tangent) in closed form against its
-    complex-step derivative, at angles from 0 through the Taylor branch (|θ|² < 10⁻²) and its
-    edge to 6 rad: 1e-12."""
-    from dolfinx_corot.corotation.frame_triangle import _dTiT_m, _dTiT_m_complex_step
-
-    rng = np.random.default_rng(5)
-    for t in (0.0, 1e-8, 1e-4, 0.05, 0.0999, 0.1001, 0.3, 1.0, 3.0, 6.0):
-        for _ in range(10):
-            d = rng.normal(size=3)
-            th, m = t * d / np.linalg.norm(d), rng.normal(size=3)
-            A, B = np.empty((3, 3)), np.empty((3, 3))
-            _dTiT_m(th, m, A)
-            _dTiT_m_complex_step(th, m, B)
-            assert np.abs(A - B).max() <= 1e-12 * np.abs(B).max()
-
-
 @pytest.mark.parametrize("kind", list(KINDS))
 def test_tangent_matches_finite_differences(kind):
     props = KINDS[kind]

@@ -45,7 +45,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
+from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3, tangent_inv_so3_derivative
 from .transform import rotate_columns, subtract_spin_g_omega
 
 
@@ -174,40 +174,6 @@ def _grad_dot(a, da, b, db, out):
 
 
 @numba.njit(cache=True)
-def d_inverse_tangent_transpose(th, m, H):
-    """H (3, 3) = ∂(T⁻ᵀ(θ) m)/∂θ for θ, m (3,) (real).
-
-    T⁻ᵀ(θ) m = m + ½ θ × m + c θ × (θ × m), c(s) = (1 − h cot h)/s, s = |θ|², h = |θ|/2
-    (:func:`~dolfinx_corot.rotations.tangent_inv_so3`), so
-    H = −½ S(m) + c ((θ·m) I + θ mᵀ − 2 m θᵀ) + 2 c'(s) (θ × (θ × m)) θᵀ, with c and c' from their
-    Bernoulli series for s < 10⁻² (c = Σ |B₂ₖ| s^(k−1)/(2k)!)."""
-    s = th[0] * th[0] + th[1] * th[1] + th[2] * th[2]
-    if s < 1e-2:
-        c = 1.0 / 12.0 + s * (1.0 / 720.0 + s * (1.0 / 30240.0 + s * (1.0 / 1209600.0 + s / 47900160.0)))
-        dc = 1.0 / 720.0 + s * (2.0 / 30240.0 + s * (3.0 / 1209600.0 + s * 4.0 / 47900160.0))
-    else:
-        h = 0.5 * np.sqrt(s)
-        sn = np.sin(h)
-        cot = np.cos(h) / sn
-        c = (1.0 - h * cot) / s
-        dc = -(cot - h / (sn * sn)) / (8.0 * h * s) - c / s
-    tm = th[0] * m[0] + th[1] * m[1] + th[2] * m[2]
-    w = np.empty(3)  # θ × (θ × m) = θ (θ·m) − m s
-    for k in range(3):
-        w[k] = th[k] * tm - m[k] * s
-    for a in range(3):
-        for b in range(3):
-            H[a, b] = c * (th[a] * m[b] - 2.0 * m[a] * th[b]) + 2.0 * dc * w[a] * th[b]
-        H[a, a] += c * tm
-    H[0, 1] += 0.5 * m[2]
-    H[0, 2] -= 0.5 * m[1]
-    H[1, 0] -= 0.5 * m[2]
-    H[1, 2] += 0.5 * m[0]
-    H[2, 0] += 0.5 * m[1]
-    H[2, 1] -= 0.5 * m[0]
-
-
-@numba.njit(cache=True)
 def add_geometric_stiffness(l, Rr, p1, p2, GT, Ti, th1, th2, B, fbar, K):
     r"""K (12, 12) += ∂Bᵀ/∂d : f̄, the geometric part of the consistent tangent, in closed form.
 
@@ -216,7 +182,7 @@ def add_geometric_stiffness(l, Rr, p1, p2, GT, Ti, th1, th2, B, fbar, K):
 
     * N δr, δe₁ = ω × e₁;
     * E Σ_i (S_iᵀ − G) H_i δθ̄_i, H_i = ∂(T⁻ᵀ(θ) m̄_i)/∂θ at θ̄_i (Battini & Pacoste 2002's K_h;
-      :func:`d_inverse_tangent_transpose`);
+      :func:`~dolfinx_corot.rotations.tangent_inv_so3_derivative`);
     * δE f_l = −E S(f_l) Ω δd, the frame's spin ω = R_r Ω δd, Ω = Gᵀ Eᵀ;
     * −E δG m, m = m₁ + m₂: the gradients of Gᵀ's entries η/l, p_i·e₂/(p·e₂), p_i·e₁/(p·e₂), 1/l
       through δe_k = ω × e_k, δp_i = δw_i × p_i and δl = r·δd.
@@ -247,7 +213,7 @@ def add_geometric_stiffness(l, Rr, p1, p2, GT, Ti, th1, th2, B, fbar, K):
     HBs = np.zeros((3, 12))
     Hi = np.empty((3, 3))
     for i in range(2):
-        d_inverse_tangent_transpose(th1 if i == 0 else th2, fbar[1 + 3 * i:4 + 3 * i], Hi)
+        tangent_inv_so3_derivative(th1 if i == 0 else th2, fbar[1 + 3 * i:4 + 3 * i], Hi)
         for r in range(3):
             for j in range(12):
                 v = Hi[r, 0] * B[1 + 3 * i, j] + Hi[r, 1] * B[2 + 3 * i, j] + Hi[r, 2] * B[3 + 3 * i, j]

@@ -34,8 +34,7 @@ import numba
 import numpy as np
 
 from ..elements import shallow_shell
-from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
-from .frame_triangle import _dTiT_m
+from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3, tangent_inv_so3_derivative
 from .transform import (add_omega_w, force, frame_axes, linear_force, local_coordinates, positions, rotate_columns,
                         stiffness, subtract_spin_g_omega, to_global)
 
@@ -288,7 +287,8 @@ def shell_force_and_tangent(X, u, R, R0, xbar0, Kbar, sdata, f, K):
     local nodal forces and moments) and K̄_t = ∂f̄/∂d̄:
     K^l = B_lᵀ K̄_t B_l − S(g) Ω + Σ_a ∂(Ωᵀv)/∂x̄_a B_{u,a}
           + Ωᵀ Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) + Σ_a E_aᵀ M_a B_{θ,a},
-    M_a = ∂(T⁻¹(θ̄_a)ᵀ m_a)/∂θ̄_a in closed form (:func:`frame_triangle._dTiT_m`), ∂(Ωᵀv)/∂x̄
+    M_a = ∂(T⁻¹(θ̄_a)ᵀ m_a)/∂θ̄_a in closed form
+    (:func:`~dolfinx_corot.rotations.tangent_inv_so3_derivative`), ∂(Ωᵀv)/∂x̄
     by complex step of :func:`shape_spin`; K = Λᵀ K^l Λ and f = Λᵀ g. The derivation is the
     triangle's (:func:`.frame_triangle.force_and_tangent`); only Ω differs."""
     Rr, xbar, th, Ti, Om, Bl, dbar = shell_parts(X, u, R, R0, xbar0)
@@ -315,7 +315,7 @@ def shell_force_and_tangent(X, u, R, R0, xbar0, Kbar, sdata, f, K):
         m = fbar[6 * a + 3:6 * a + 6].copy()
         for i in range(3):
             v[i] -= Ti[a, 0, i] * m[0] + Ti[a, 1, i] * m[1] + Ti[a, 2, i] * m[2]
-        _dTiT_m(th[a], m, M[a])
+        tangent_inv_so3_derivative(th[a], m, M[a])
     # Σ_a ∂(Ωᵀv)/∂x̄_a B_{u,a}: J (24, 12) by complex step of Ω(y) at y = x̄
     yc = np.empty((4, 3), dtype=np.complex128)
     Omc = np.empty((3, 24), dtype=np.complex128)

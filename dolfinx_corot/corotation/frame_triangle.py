@@ -28,7 +28,7 @@ Consistent tangent (:func:`force_and_tangent`), differentiating f = Λᵀ B_lᵀ
 f̄ = K̄ d̄: the frame turns (δΛᵀ g = Λᵀ(ω × g) blockwise), Ω changes with the
 side length l and the coordinates (b₁, b₂) of node 3, x̄_a moves, and T⁻¹(θ̄_a)
 changes with θ̄_a (its derivative contracted with the nodal moment, in closed
-form: :func:`_dTiT_m`). :func:`basic` and :func:`parts` are
+form: :func:`~dolfinx_corot.rotations.tangent_inv_so3_derivative`). :func:`basic` and :func:`parts` are
 complex-analytic, so the closed form is checked against complex-step
 differentiation of the internal force (tests).
 """
@@ -38,7 +38,7 @@ import numba
 import numpy as np
 
 from ..elements import shallow_shell
-from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3
+from ..rotations import cross, dot, log_so3, matmul3, matmul3_tn, tangent_inv_so3, tangent_inv_so3_derivative
 from .transform import (add_omega_w, force, frame_axes, linear_force, local_coordinates, positions, rotate_columns,
                         stiffness, subtract_spin_g_omega, to_global)
 
@@ -169,54 +169,6 @@ def internal_force(X, u, R, R0, xbar0, Kbar, sdata, f, rotations=True):
 
 
 @numba.njit(cache=True)
-def _dTiT_m(th, m, M):
-    """M (3, 3) = ∂(T⁻¹(θ)ᵀ m)/∂θ in closed form. With W = spin(θ), s = |θ|² and
-    T⁻¹ = I − ½W + c(s)W² (c = (1 − (t/2)cot(t/2))/t², t = |θ|):
-    T⁻ᵀm = m + ½θ × m + c v, v = θ(θ·m) − s m, so that
-    M = −½ spin(m) + c((θ·m)I + θmᵀ − 2mθᵀ) + 2c′(s) v θᵀ, with
-    c′(s) = −(cot h − h/sin²h)/(32h³) − c/s (h = t/2), or its Taylor series
-    1/720 + s/15120 + s²/403200 for s < 10⁻² (where the closed form would cancel).
-    :func:`_dTiT_m_complex_step` is the reference it is tested against."""
-    s = th[0] * th[0] + th[1] * th[1] + th[2] * th[2]
-    if s < 1e-2:
-        c = 1.0 / 12.0 + s / 720.0 + s * s / 30240.0 + s * s * s / 1209600.0
-        dc = 1.0 / 720.0 + s / 15120.0 + s * s / 403200.0
-    else:
-        h = 0.5 * np.sqrt(s)
-        sn, cs = np.sin(h), np.cos(h)
-        cot = cs / sn
-        c = (1.0 - h * cot) / s
-        dc = -(cot - h / (sn * sn)) / (32.0 * h * h * h) - c / s
-    tm = th[0] * m[0] + th[1] * m[1] + th[2] * m[2]
-    for i in range(3):
-        vi = th[i] * tm - s * m[i]
-        for j in range(3):
-            M[i, j] = c * (th[i] * m[j] - 2.0 * m[i] * th[j]) + 2.0 * dc * vi * th[j]
-        M[i, i] += c * tm
-    # −½ spin(m)
-    M[0, 1] += 0.5 * m[2]
-    M[0, 2] -= 0.5 * m[1]
-    M[1, 0] -= 0.5 * m[2]
-    M[1, 2] += 0.5 * m[0]
-    M[2, 0] += 0.5 * m[1]
-    M[2, 1] -= 0.5 * m[0]
-
-
-@numba.njit(cache=True)
-def _dTiT_m_complex_step(th, m, M):
-    """M (3, 3) = ∂(T⁻¹(θ)ᵀ m)/∂θ by complex-step differentiation of a 3-vector function."""
-    h = 1e-30
-    thc = np.empty(3, dtype=np.complex128)
-    Tc = np.empty((3, 3), dtype=np.complex128)
-    for j in range(3):
-        thc[:] = th
-        thc[j] += 1j * h
-        tangent_inv_so3(thc, Tc)
-        for i in range(3):
-            M[i, j] = (Tc[0, i] * m[0] + Tc[1, i] * m[1] + Tc[2, i] * m[2]).imag / h
-
-
-@numba.njit(cache=True)
 def force_and_tangent(X, u, R, R0, xbar0, Kbar, sdata, f, K, rotations=True):
     """f = Bᵀ f̄(d̄) (the local law of :func:`internal_force`) and its consistent tangent
     K = ∂f/∂d in closed form.
@@ -253,7 +205,7 @@ def force_and_tangent(X, u, R, R0, xbar0, Kbar, sdata, f, K, rotations=True):
             m = fbar[6 * a + 3:6 * a + 6].copy()
             for i in range(3):
                 v[i] -= Ti[a, 0, i] * m[0] + Ti[a, 1, i] * m[1] + Ti[a, 2, i] * m[2]
-            _dTiT_m(th[a], m, M[a])
+            tangent_inv_so3_derivative(th[a], m, M[a])
     # ∂(Ωᵀ v)/∂(l, b1, b2) and the variations of l, b1, b2
     dc_l = np.zeros(18)
     dc_b1 = np.zeros(18)

@@ -25,8 +25,9 @@ Their variation, with ω the spin of the frame in its own axes:
 (from :math:`\delta\mathbf e_3 = \boldsymbol\omega\times\mathbf e_3`, :math:`\delta\mathbf e_1 = \boldsymbol\omega\times\mathbf e_1`),
 :math:`\delta\mathbf n = \delta\mathbf d_1\times\mathbf d_2 + \mathbf d_1\times\delta\mathbf d_2`,
 :math:`\delta\hat{\mathbf d} = (\mathbf I - \hat{\mathbf d}\hat{\mathbf d}^T)\,\delta\mathbf d/|\mathbf d|`.
-All functions are complex-analytic: the kernel's tangent is a complex-step
-derivative of f = Bᵀ f̄.
+All functions are complex-analytic: the membrane kernel's tangent is a complex-step
+derivative of f = Bᵀ f̄; the shell's is in closed form (:func:`shell_force_and_tangent`), and
+complex steps are its tests' reference.
 """
 from __future__ import annotations
 
@@ -132,8 +133,8 @@ def basic(X, u, xbar0, dbar, B):
 # components (d^l = Λd, Λ = blockdiag(R_rᵀ)), 6 dofs per node:
 #     δū_a = δu_a − δu_c + x̄_a × ω,   δθ̄_a = T⁻¹(θ̄_a)(δw_a − ω),   ω = Ω(x̄) δu^l,
 # as for the triangle (:mod:`.frame_triangle`). Ω depends on the element's shape alone, so its
-# variation contracted with a vector, ∂(Ωᵀv)/∂x̄, is taken by complex step of :func:`shape_spin`
-# (12 evaluations of a few cross products) in :func:`shell_force_and_tangent`.
+# variation contracted with a vector, ∂(Ωᵀv)/∂x̄, is :func:`shape_spin_derivative` (closed form,
+# tested against complex steps of :func:`shape_spin`) in :func:`shell_force_and_tangent`.
 
 
 @numba.njit(cache=True, inline="always")
@@ -146,7 +147,7 @@ def shape_spin(y, Om):
     """Om (3, 24): the frame spin in the frame's own axes, ω = Ω δd^l, for nodes at y (4, 3) and
     variations δd^l (6 per node) in the frame's components. A function of the shape of y alone
     (invariant under rigid motions of y), complex-analytic; scalar arithmetic (no arrays made:
-    the tangent calls it twelve times)."""
+    its complex-step derivative is the reference of :func:`shape_spin_derivative`)."""
     d10, d11, d12 = y[2, 0] - y[0, 0], y[2, 1] - y[0, 1], y[2, 2] - y[0, 2]
     d20, d21, d22 = y[3, 0] - y[1, 0], y[3, 1] - y[1, 1], y[3, 2] - y[1, 2]
     n0, n1, n2 = _cross(d10, d11, d12, d20, d21, d22)
@@ -194,6 +195,172 @@ def shape_spin(y, Om):
         Om[2, k] -= w[0]
         Om[2, 18 + k] += w[1]
         Om[2, 6 + k] -= w[1]
+
+
+@numba.njit(cache=True, inline="always")
+def _skew(a, S):
+    """S (3, 3) = spin(a): S b = a × b."""
+    S[0, 0] = 0.0
+    S[0, 1] = -a[2]
+    S[0, 2] = a[1]
+    S[1, 0] = a[2]
+    S[1, 1] = 0.0
+    S[1, 2] = -a[0]
+    S[2, 0] = -a[1]
+    S[2, 1] = a[0]
+    S[2, 2] = 0.0
+
+
+@numba.njit(cache=True)
+def shape_spin_derivative(y, v, J):
+    r"""J (24, 12) = ∂(Ω(y)ᵀ v)/∂y for nodes at y (4, 3) and a fixed v (3,), in closed form.
+
+    Ωᵀv δd = q·δn + r·δm with q = (v₂e₁ − v₁e₂)/|n|, r = v₃e₂/|m|, so that the translation rows
+    of nodes 1 and 3 are ∓Eᵀg₁ and those of nodes 2 and 4 ∓Eᵀg₂ (the variations δd in the frame's
+    components, E = [e₁ e₂ e₃]), g₁ = d₂ × q + P₁r/l₁, g₂ = q × d₁ − P₂r/l₂ (P_i = I − ĥ_iĥ_iᵀ).
+    Their derivatives with respect to d₁ = y₃ − y₁ and d₂ = y₄ − y₂, Eᵀ∂g + (gᵀ∂e_k)_k, follow from
+    δn = δd₁ × d₂ + d₁ × δd₂, δe₃ = (I − e₃e₃ᵀ)δn/|n|, δm = P₁δd₁/l₁ − P₂δd₂/l₂,
+    δe₁ = (I − e₁e₁ᵀ)δm/|m|, δe₂ = δe₃ × e₁ + e₃ × δe₁. Tested against the complex-step derivative
+    of :func:`shape_spin`."""
+    d1 = y[2] - y[0]
+    d2 = y[3] - y[1]
+    n = np.empty(3)
+    cross(d1, d2, n)
+    nn = np.sqrt(dot(n, n))
+    l1 = np.sqrt(dot(d1, d1))
+    l2 = np.sqrt(dot(d2, d2))
+    h1 = d1 / l1
+    h2 = d2 / l2
+    m = h1 - h2
+    mm = np.sqrt(dot(m, m))
+    e1 = m / mm
+    e3 = n / nn
+    e2 = np.empty(3)
+    cross(e3, e1, e2)
+    q = (v[1] * e1 - v[0] * e2) / nn
+    r = v[2] * e2 / mm
+    P1 = np.empty((3, 3))
+    P2 = np.empty((3, 3))
+    Q1 = np.empty((3, 3))
+    Q3 = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            dij = 1.0 if i == j else 0.0
+            P1[i, j] = dij - h1[i] * h1[j]
+            P2[i, j] = dij - h2[i] * h2[j]
+            Q1[i, j] = (dij - e1[i] * e1[j]) / mm
+            Q3[i, j] = (dij - e3[i] * e3[j]) / nn
+    Sd1 = np.empty((3, 3))
+    Sd2 = np.empty((3, 3))
+    Se1 = np.empty((3, 3))
+    Se3 = np.empty((3, 3))
+    _skew(d1, Sd1)
+    _skew(d2, Sd2)
+    _skew(e1, Se1)
+    _skew(e3, Se3)
+    g = np.empty((2, 3))  # g₁, g₂
+    cross(d2, q, g[0])
+    cross(q, d1, g[1])
+    hr1 = dot(h1, r)
+    hr2 = dot(h2, r)
+    for a in range(3):
+        g[0, a] += (r[a] - h1[a] * hr1) / l1
+        g[1, a] -= (r[a] - h2[a] * hr2) / l2
+    dn = np.empty((3, 3))
+    dm = np.empty((3, 3))
+    de = np.empty((3, 3, 3))  # ∂e_c/∂d_k, c = 0, 1, 2
+    tmp = np.empty((3, 3))
+    dq = np.empty((3, 3))
+    dr = np.empty((3, 3))
+    D = np.empty((2, 2, 3, 3))  # ∂(Eᵀg_i)/∂d_k
+    for k in range(2):
+        for i in range(3):
+            for j in range(3):
+                dn[i, j] = -Sd2[i, j] if k == 0 else Sd1[i, j]             # ∂n/∂d_k
+                dm[i, j] = P1[i, j] / l1 if k == 0 else -P2[i, j] / l2     # ∂m/∂d_k
+        matmul3(Q3, dn, de[2])
+        matmul3(Q1, dm, de[0])
+        matmul3(Se1, de[2], tmp)
+        matmul3(Se3, de[0], de[1])
+        for i in range(3):
+            for j in range(3):
+                de[1, i, j] -= tmp[i, j]
+        for j in range(3):
+            e3dn = e3[0] * dn[0, j] + e3[1] * dn[1, j] + e3[2] * dn[2, j]
+            e1dm = e1[0] * dm[0, j] + e1[1] * dm[1, j] + e1[2] * dm[2, j]
+            for i in range(3):
+                dq[i, j] = (v[1] * de[0, i, j] - v[0] * de[1, i, j] - q[i] * e3dn) / nn
+                dr[i, j] = (v[2] * de[1, i, j] - r[i] * e1dm) / mm
+        for gi in range(2):
+            # ∂g_i/∂d_k, in tmp
+            if gi == 0:
+                matmul3(Sd2, dq, tmp)      # d₂ × ∂q
+                for i in range(3):
+                    for j in range(3):
+                        tmp[i, j] += (P1[i, 0] * dr[0, j] + P1[i, 1] * dr[1, j] + P1[i, 2] * dr[2, j]) / l1
+                if k == 1:                 # −q × δd₂
+                    tmp[0, 1] += q[2]
+                    tmp[0, 2] -= q[1]
+                    tmp[1, 0] -= q[2]
+                    tmp[1, 2] += q[0]
+                    tmp[2, 0] += q[1]
+                    tmp[2, 1] -= q[0]
+                else:                      # P₁r/l₁ through ĥ₁ and l₁
+                    for i in range(3):
+                        Pr = r[i] - h1[i] * hr1
+                        for j in range(3):
+                            rP = r[0] * P1[0, j] + r[1] * P1[1, j] + r[2] * P1[2, j]
+                            tmp[i, j] -= (hr1 * P1[i, j] + h1[i] * rP + Pr * h1[j]) / (l1 * l1)
+            else:
+                matmul3(Sd1, dq, tmp)      # −d₁ × ∂q
+                for i in range(3):
+                    for j in range(3):
+                        tmp[i, j] = -tmp[i, j] - (P2[i, 0] * dr[0, j] + P2[i, 1] * dr[1, j] + P2[i, 2] * dr[2, j]) / l2
+                if k == 0:                 # q × δd₁
+                    tmp[0, 1] -= q[2]
+                    tmp[0, 2] += q[1]
+                    tmp[1, 0] += q[2]
+                    tmp[1, 2] -= q[0]
+                    tmp[2, 0] -= q[1]
+                    tmp[2, 1] += q[0]
+                else:                      # −P₂r/l₂ through ĥ₂ and l₂
+                    for i in range(3):
+                        Pr = r[i] - h2[i] * hr2
+                        for j in range(3):
+                            rP = r[0] * P2[0, j] + r[1] * P2[1, j] + r[2] * P2[2, j]
+                            tmp[i, j] += (hr2 * P2[i, j] + h2[i] * rP + Pr * h2[j]) / (l2 * l2)
+            # in the frame's components: Eᵀ ∂g_i/∂d_k + (g_iᵀ ∂e_c/∂d_k)_c
+            for c in range(3):
+                ec = e1 if c == 0 else (e2 if c == 1 else e3)
+                for j in range(3):
+                    D[gi, k, c, j] = (ec[0] * tmp[0, j] + ec[1] * tmp[1, j] + ec[2] * tmp[2, j]
+                                      + g[gi, 0] * de[c, 0, j] + g[gi, 1] * de[c, 1, j] + g[gi, 2] * de[c, 2, j])
+    J[:, :] = 0.0
+    # rows: node 1 −g₁, node 3 +g₁, node 2 −g₂, node 4 +g₂; columns: y₁ −d₁, y₃ +d₁, y₂ −d₂, y₄ +d₂
+    for i, (row_minus, row_plus) in enumerate(((0, 12), (6, 18))):
+        for k, (col_minus, col_plus) in enumerate(((0, 6), (3, 9))):
+            for a in range(3):
+                for b in range(3):
+                    x = D[i, k, a, b]
+                    J[row_minus + a, col_minus + b] += x
+                    J[row_minus + a, col_plus + b] -= x
+                    J[row_plus + a, col_minus + b] -= x
+                    J[row_plus + a, col_plus + b] += x
+
+
+@numba.njit(cache=True)
+def shape_spin_derivative_complex_step(y, v, J):
+    """:func:`shape_spin_derivative` by complex steps of :func:`shape_spin` (its test's reference)."""
+    yc = np.empty((4, 3), dtype=np.complex128)
+    Omc = np.empty((3, 24), dtype=np.complex128)
+    for j in range(12):
+        for a in range(4):
+            for k in range(3):
+                yc[a, k] = y[a, k]
+        yc[j // 3, j % 3] += 1j * H
+        shape_spin(yc, Omc)
+        for i in range(24):
+            J[i, j] = (Omc[0, i] * v[0] + Omc[1, i] * v[1] + Omc[2, i] * v[2]).imag / H
 
 
 @numba.njit(cache=True)
@@ -289,7 +456,7 @@ def shell_force_and_tangent(X, u, R, R0, xbar0, Kbar, sdata, f, K):
           + Ωᵀ Σ_a (spin(n_a) B_{u,a} − M_a B_{θ,a}) + Σ_a E_aᵀ M_a B_{θ,a},
     M_a = ∂(T⁻¹(θ̄_a)ᵀ m_a)/∂θ̄_a in closed form
     (:func:`~dolfinx_corot.rotations.tangent_inv_so3_derivative`), ∂(Ωᵀv)/∂x̄
-    by complex step of :func:`shape_spin`; K = Λᵀ K^l Λ and f = Λᵀ g. The derivation is the
+    by :func:`shape_spin_derivative`; K = Λᵀ K^l Λ and f = Λᵀ g. The derivation is the
     triangle's (:func:`.frame_triangle.force_and_tangent`); only Ω differs."""
     Rr, xbar, th, Ti, Om, Bl, dbar = shell_parts(X, u, R, R0, xbar0)
     fbar = np.empty(24)
@@ -316,18 +483,9 @@ def shell_force_and_tangent(X, u, R, R0, xbar0, Kbar, sdata, f, K):
         for i in range(3):
             v[i] -= Ti[a, 0, i] * m[0] + Ti[a, 1, i] * m[1] + Ti[a, 2, i] * m[2]
         tangent_inv_so3_derivative(th[a], m, M[a])
-    # Σ_a ∂(Ωᵀv)/∂x̄_a B_{u,a}: J (24, 12) by complex step of Ω(y) at y = x̄
-    yc = np.empty((4, 3), dtype=np.complex128)
-    Omc = np.empty((3, 24), dtype=np.complex128)
+    # Σ_a ∂(Ωᵀv)/∂x̄_a B_{u,a}
     J = np.empty((24, 12))
-    for j in range(12):
-        for a in range(4):
-            for k in range(3):
-                yc[a, k] = xbar[a, k]
-        yc[j // 3, j % 3] += 1j * H
-        shape_spin(yc, Omc)
-        for i in range(24):
-            J[i, j] = (Omc[0, i] * v[0] + Omc[1, i] * v[1] + Omc[2, i] * v[2]).imag / H
+    shape_spin_derivative(xbar, v, J)
     for i in range(24):
         for j in range(24):
             acc = 0.0

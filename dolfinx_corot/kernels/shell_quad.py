@@ -8,8 +8,7 @@ Nodal state (7 per node): displacement (3) and unit quaternion (4); element vect
   (e₁ between the diagonals, e₃ their normal: independent of which node is numbered first) and
   the linear flat element of :mod:`dolfinx_corot.elements.shell_quad` (incompatible-mode
   membrane with drilling rotations, MITC4 bending and shear, rigid links for warping);
-  consistent tangent in closed form but for the frame spin's variation, which is a complex-step
-  derivative of a few cross products (:func:`frame_quad.shell_force_and_tangent`).
+  consistent tangent in closed form (:func:`frame_quad.shell_force_and_tangent`).
 * :func:`corotational_complex_step`: the same f, K by complex-step differentiation of f,
   node 4's columns from invariance: the reference the closed form is tested against.
 * :func:`linear`: K = B₀ᵀ K̄ B₀ in the initial frame, f = K d with nodal rotation vectors.

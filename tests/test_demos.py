@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 DEMO_DIR = ROOT / "demos"
 DEMOS = sorted(p.stem for p in DEMO_DIR.glob("*.py"))
 MPI_DEMOS = ["euler_beam_2d", "cantilever_rollup_2d", "lee_frame", "curved_beam_3d", "rollup_3d", "truss_dome_3d",
-             "strip_rollup", "cylinder_pullout", "hinged_sphere", "hinged_roof", "slit_annular_plate", "stiffened_strip", "euler_continuum_2d", "euler_continuum_3d", "hertz_2d", "contact_patch_test", "two_wheels", "beam_on_soil_2d", "lining_in_gap", "frame_filling_2", "hertz_3d", "pipe_on_soil_3d", "shell_on_soil_3d",
+             "strip_rollup", "cylinder_pullout", "hinged_sphere", "hinged_roof", "pinched_hemisphere", "slit_annular_plate", "stiffened_strip", "euler_continuum_2d", "euler_continuum_3d", "hertz_2d", "contact_patch_test", "two_wheels", "beam_on_soil_2d", "lining_in_gap", "frame_filling_2", "hertz_3d", "pipe_on_soil_3d", "shell_on_soil_3d",
              "contact_patch_test_3d", "sliding_sphere_3d", "cattaneo_mindlin_2d", "ironing_2d", "ironing_3d"]
 
 # Demos whose two-rank numbers may depart from the serial ones by more than the solver's

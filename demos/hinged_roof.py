@@ -56,6 +56,19 @@ TABLE = np.array([
     [0.5093, 25.293], [0.5826, 25.940], [0.6644, 26.601], [0.7551, 27.276], [0.8549, 27.964],
     [0.9643, 28.663], [1.0835, 29.374]])
 W_REF, P_REF = TABLE[:, 1], P_MAX * TABLE[:, 0]
+SZE_LAMINATE = ("Sze, Liu & Lo (2004), §3.8: hinged cylindrical roof, t = 12.7, laminate [0/90/0] "
+                "(E1 = 3300, E2 = 1100, G = 660, ν12 = 0.25; ABAQUS S4R)")
+# the same roof as a laminate [0/90/0] of three equal plies, 0° along the axis: (P/P_max, −W_C)
+TABLE_LAMINATE = np.array([
+    [0.0000, 0.000], [0.0546, 0.807], [0.1245, 1.956], [0.1938, 3.281], [0.2494, 4.548],
+    [0.2925, 5.753], [0.3244, 6.892], [0.3459, 7.961], [0.3582, 8.959], [0.3618, 9.884],
+    [0.3577, 10.735], [0.3464, 11.516], [0.3288, 12.227], [0.3057, 12.872], [0.2778, 13.458],
+    [0.2461, 13.990], [0.2115, 14.477], [0.1749, 14.928], [0.0999, 15.774], [0.0638, 16.199],
+    [0.0303, 16.648], [0.0007, 17.141], [-0.0236, 17.692], [-0.0411, 18.317], [-0.0504, 19.024],
+    [-0.0503, 19.817], [-0.0394, 20.698], [-0.0165, 21.663], [0.0194, 22.707], [0.0697, 23.824],
+    [0.1354, 25.005], [0.2178, 26.244], [0.3181, 27.533], [0.4374, 28.864], [0.5769, 30.229],
+    [0.7374, 31.622], [1.0192, 33.748]])
+PLY = dc.Orthotropic(E1=3300.0, E2=1100.0, G12=660.0, nu12=0.25, G13=660.0, G23=660.0)
 
 
 def quarter_roof(n, quads=False):
@@ -69,17 +82,22 @@ def quarter_roof(n, quads=False):
     return from_arrays(pts, cells, "roof", groups, comm=comm)
 
 
-def roof(n, quads=False, steps=60):
-    """(W_C, P) from the unloaded state (the whole roof's force), the result and the wall time."""
+def roof(n, quads=False, steps=60, laminate=False, w_end=W_END):
+    """(W_C, P) from the unloaded state (the whole roof's force), the result and the wall time;
+    ``laminate``: three equal plies [0/90/0], 0° along the roof's axis."""
     scene = dc.Scene(large_rotations=True)
-    shell = scene.add_shell(quarter_roof(n, quads), "roof", thickness=t, material=dc.Elastic(E, nu))
+    if laminate:
+        section = dc.Laminate([dc.Ply(t / 3, angle, PLY) for angle in (0.0, 90.0, 0.0)])
+        shell = scene.add_shell(quarter_roof(n, quads), "roof", section=section, axis=(1.0, 0.0, 0.0))
+    else:
+        shell = scene.add_shell(quarter_roof(n, quads), "roof", thickness=t, material=dc.Elastic(E, nu))
     scene.fix(shell, "mid", dofs=("ux", "ry", "rz"))     # plane x = 0
     scene.fix(shell, "crown", dofs=("uy", "rx", "rz"))   # plane y = 0
     scene.fix(shell, "hinged", dofs=("ux", "uy", "uz"))  # the straight edge: hinged
-    scene.prescribe(shell, "C", uz=-W_END)
+    scene.prescribe(shell, "C", uz=-w_end)
     scene.monitor_reaction("C", shell, "C")
     res, wall = timed(dc.solve, scene, dc.LoadControl(steps=steps))
-    w = np.r_[0.0, W_END * res.history.column("load_factor")]
+    w = np.r_[0.0, w_end * res.history.column("load_factor")]
     P = np.r_[0.0, -4.0 * res.history.column("C_Fz")]  # four quarters
     return w, P, res, wall
 
@@ -94,6 +112,7 @@ def extrema(w, P):
 
 
 PEAK_REF, VALLEY_REF, W3000_REF = extrema(W_REF, P_REF)
+LAMINATE_REF = extrema(TABLE_LAMINATE[:, 1], P_MAX * TABLE_LAMINATE[:, 0])
 
 
 def path_error(w, P):
@@ -149,6 +168,33 @@ def plot(demo, tri, quad):
 
 
 # %% [markdown]
+# ## The roof as a laminate
+#
+# Sze, Liu & Lo also tabulate the same roof as a cross-ply laminate [0/90/0] (three equal
+# plies, 0° along the axis; $E_1 = 3300$, $E_2 = 1100$, $G_{12} = G_{13} = G_{23} = 660$,
+# $\nu_{12} = 0.25$; lamination theory, `dc.Laminate`). It is much softer: the limit load is
+# about a third of the isotropic roof's, and after the snap the force turns negative (the
+# roof pulls the load point) before the inverted roof takes load again.
+
+# %%
+def laminated_roof(demo):
+    """(family, n, P_max, valley, W_C at P = 3000, wall) on one mesh of each family."""
+    n = 8 if demo.ci else 16
+    rows = []
+    for quads in (False, True):
+        w, P, res, wall = roof(n, quads, steps=69, laminate=True, w_end=34.5)
+        peak, valley, w3000 = extrema(w, P)
+        rows.append((float(quads), n, peak, valley, w3000, wall))
+        demo.say(f"laminate [0/90/0], {'quadrilaterals' if quads else 'triangles'} {n} x {n}: P_max = {peak:.1f} "
+                 f"({100 * (peak / LAMINATE_REF[0] - 1):+.2f} %), valley {valley:.1f} (table {LAMINATE_REF[1]:.1f}), "
+                 f"W_C at P = 3000 {w3000:.3f} ({100 * (w3000 / LAMINATE_REF[2] - 1):+.2f} %), {wall:.1f} s, "
+                 f"{res.totals['cuts']} cuts")
+    rows = np.array(rows)
+    demo.table("laminate.csv", rows, ["quadrilaterals", "n", "P_max", "P_valley", "W_C_at_3000", "wall_s"])
+    return rows
+
+
+# %% [markdown]
 # ## Verification
 
 # %%
@@ -158,6 +204,7 @@ def main() -> dict:
     tri, tri_curves = three_meshes(demo)
     quad, quad_curves = three_meshes(demo, quads=True)
     plot(demo, tri_curves, quad_curves)
+    laminated = laminated_roof(demo)
     for rows, label in ((tri, "triangles (OPT + DKT)"), (quad, "quadrilaterals (DKQ)")):
         demo.work_precision(rows[:, 0].astype(int), rows[:, 1] / PEAK_REF - 1.0, rows[:, 5], series=label,
                             quantity="limit load (squares along an edge of the quarter)", reference=SZE)
@@ -179,6 +226,14 @@ def main() -> dict:
         d1, d2 = abs(rows[1, 1] - rows[0, 1]), abs(rows[2, 1] - rows[1, 1])
         demo.check(f"{family}: change of the limit load on the last refinement / on the first", d2 / d1, bound=0.5,
                    reference="self-convergence (the table itself is a converged S4R solution)")
+    for row in laminated:
+        family = "quadrilaterals" if row[0] else "triangles"
+        demo.check(f"laminate, {family}: limit load", row[2], LAMINATE_REF[0], rtol=0.01, reference=SZE_LAMINATE)
+        demo.check(f"laminate, {family}: valley (negative: the roof pulls) / limit load",
+                   (row[3] - LAMINATE_REF[1]) / LAMINATE_REF[0], 0.0, atol=0.01, reference=SZE_LAMINATE)
+        demo.check(f"laminate, {family}: W_C where the inverted roof carries P = 3000", row[4], LAMINATE_REF[2],
+                   rtol=0.01, reference=SZE_LAMINATE)
+    demo.record(laminate=laminated[:, 2:5])
     demo.check("quadrilaterals / triangles: error of the limit load on the coarsest mesh (the same nodes)",
                abs(quad[0, 1] / PEAK_REF - 1.0) / abs(tri[0, 1] / PEAK_REF - 1.0), bound=1.0, reference=SZE)
     demo.check("quadrilaterals / triangles: path error on the coarsest mesh (the same nodes)",

@@ -67,8 +67,9 @@ def quarter_hemisphere(n, quads=False):
     return from_arrays(pts, cells, "hemisphere", groups, comm=comm)
 
 
-def hemisphere(n, quads=False, steps=40):
-    """(P/P_max, u_A, −u_B) per step, the result and the wall time."""
+def hemisphere(n, quads=False, steps=40, demo=None):
+    """(P/P_max, u_A, −u_B) per step, the result and the wall time; with ``demo``, the quarter at
+    P = 100, 200, 300 and 400 in ``hemisphere_shapes.png``."""
     scene = dc.Scene(large_rotations=True)
     shell = scene.add_shell(quarter_hemisphere(n, quads), "hemisphere", thickness=t, material=dc.Elastic(E, nu))
     scene.fix(shell, "xz", dofs=("uy", "rx", "rz"))  # plane y = 0
@@ -78,7 +79,11 @@ def hemisphere(n, quads=False, steps=40):
     scene.load(shell, "B", force=(0.0, -P_MAX / 2, 0.0))
     scene.monitor("A", shell, "A")
     scene.monitor("B", shell, "B")
-    res, wall = timed(dc.solve, scene, dc.LoadControl(steps=steps))
+    shots = dc.plot.Snapshots(scene, at=(0.25, 0.5, 0.75, 1.0)) if demo is not None else None
+    res, wall = timed(dc.solve, scene, dc.LoadControl(steps=steps), on_step=shots)
+    if demo is not None:  # the last state first: the views share the first one's camera
+        demo.picture(shots.states, "hemisphere_shapes.png", field="displacement", layout="grid", columns=2,
+                     window_size=(1200, 1000), title=f"Pinched hemisphere ({n} x {n} quarter)")
     h = res.history
     return np.c_[h.column("load_factor"), h.column("A_ux"), -h.column("B_uy")], res, wall
 
@@ -96,8 +101,9 @@ def errors(path):
 def three_meshes(demo, quads=False):
     rows, paths = [], {}
     family = "quadrilaterals" if quads else "triangles"
-    for n in ([8, 12, 16] if demo.ci else [8, 16, 32]):
-        path, res, wall = hemisphere(n, quads)
+    meshes = [8, 12, 16] if demo.ci else [8, 16, 32]
+    for n in meshes:
+        path, res, wall = hemisphere(n, quads, demo=demo if quads and n == meshes[-1] else None)
         err = errors(path)
         paths[n] = path
         rows.append((n, path[-1, 1], path[-1, 2], err[-1, 0], err[-1, 1], np.abs(err).max(), np.abs(err[0]).max(),
@@ -139,7 +145,8 @@ def main() -> dict:
     for rows, label in ((tri, "triangles (OPT + DKT)"), (quad, "quadrilaterals (DKQ)")):
         demo.work_precision(rows[:, 0].astype(int), rows[:, 5], rows[:, 7], series=label, reference=SZE,
                             quantity="largest error of u_A, -u_B along the path (squares along an edge of the quarter)")
-    demo.record(triangles=tri[:, 1:7], quadrilaterals=quad[:, 1:7], path=list(quad_paths.values())[-1])
+    path = list(quad_paths.values())[-1]
+    demo.record(load_factor=path[:, 0], triangles=tri[:, 1:7], quadrilaterals=quad[:, 1:7], path=path)
     solver = "solver acceptance (no published value)"
     for rows, family in ((tri, "triangles"), (quad, "quadrilaterals")):
         demo.check(f"{family}: u_A and -u_B at P = 400, finest mesh", rows[-1, 3:5], 0.0, atol=0.025, reference=SZE)

@@ -38,7 +38,7 @@ from mpi4py import MPI
 import dolfinx_corot as dc
 from dolfinx_corot.gallery import Demo, timed
 from dolfinx_corot.io import from_arrays
-from dolfinx_corot.result import limit_load
+from dolfinx_corot.result import limit_load, path_distance
 
 comm = MPI.COMM_WORLD
 R, L, THETA, t, E, nu = 2540.0, 508.0, 0.1, 12.7, 3102.75, 0.3
@@ -125,14 +125,8 @@ def path_error(w, P):
     its value at the table's valley and P by the table's limit load (the descending branch is
     steep: a distance, not a difference of P at equal W_C)."""
     w_scale = W_REF[np.argmin(np.where(W_REF > 15.0, P_REF, np.inf))]
-    a = np.c_[w[:-1], P[:-1]] / [w_scale, PEAK_REF]
-    b = np.c_[w[1:], P[1:]] / [w_scale, PEAK_REF]
-    worst = 0.0
-    for q in np.c_[W_REF, P_REF][W_REF <= 20.0] / [w_scale, PEAK_REF]:
-        d = b - a
-        s = np.clip(np.einsum("ij,ij->i", q - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
-        worst = max(worst, float(np.min(np.linalg.norm(a + s[:, None] * d - q, axis=1))))
-    return worst
+    table = np.c_[W_REF, P_REF][W_REF <= 20.0]
+    return float(path_distance(np.c_[w, P], table, [w_scale, PEAK_REF]).max())
 
 
 # %% [markdown]

@@ -336,3 +336,20 @@ def limit_load(load: np.ndarray, *coordinates: np.ndarray, kind: str = "max", fi
     s = np.concatenate([[0.0], np.cumsum(np.sqrt((np.diff(xs, axis=1) ** 2).sum(axis=0)))])
     c = np.polyfit(s[k - 1:k + 2], lam[k - 1:k + 2], 2)
     return float(c[2] - c[1] ** 2 / (4 * c[0]))
+
+
+def path_distance(path: np.ndarray, points: np.ndarray, scale) -> np.ndarray:
+    """Distances of reference points from a traced path: path (n, k), the polyline through the
+    path's states (e.g. columns displacement, load); points (m, k), e.g. a published table;
+    scale (k,) divides each coordinate first, so that the distance is relative. Returns (m,).
+
+    Where a curve is steep, a difference of loads at equal displacement (or the reverse)
+    magnifies small offsets; the distance from the polyline does not."""
+    a = np.asarray(path, dtype=float)[:-1] / scale
+    d = np.asarray(path, dtype=float)[1:] / scale - a
+    dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
+    out = np.empty(len(points))
+    for i, q in enumerate(np.asarray(points, dtype=float) / scale):
+        s = np.clip(np.einsum("ij,ij->i", q - a, d) / dd, 0.0, 1.0)
+        out[i] = np.min(np.linalg.norm(a + s[:, None] * d - q, axis=1))
+    return out

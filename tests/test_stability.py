@@ -14,7 +14,7 @@ from mpi4py import MPI
 import dolfinx_corot as dc
 from dolfinx_corot.io.gmsh_models import polyline
 from dolfinx_corot.io.mesh import box, from_arrays
-from dolfinx_corot.result import limit_load
+from dolfinx_corot.result import limit_load, path_distance
 
 E, B, H, L = 1.0e6, 0.01, 0.01, 1.0
 I_WEAK = B * H**3 / 12
@@ -213,6 +213,21 @@ def test_limit_load_says_when_the_path_has_no_maximum():
                                          "last point"):
         limit_load(lam, lam**2)
     assert limit_load(np.array([0.0, 1.0, 1.6, 1.4]), np.array([0.0, 1.0, 2.0, 3.0])) == pytest.approx(1.625)
+
+
+def test_path_distance_of_reference_points():
+    """The distance of points from a traced path (a polyline) after scaling each coordinate: a
+    point on a segment is at 0, one off a vertical segment at its horizontal offset, one beyond
+    the end at its distance from the last state; on a steep segment the distance stays small
+    where a difference of loads at equal displacement is large."""
+    path = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 3.0]])
+    points = np.array([[0.5, 0.5], [1.2, 2.0], [1.0, 4.0], [0.0, 1.0]])
+    d = path_distance(path, points, [1.0, 1.0])
+    np.testing.assert_allclose(d, [0.0, 0.2, 1.0, np.sqrt(0.5)], atol=1e-15)
+    # scaled: x by 2, y by 10
+    np.testing.assert_allclose(path_distance(path, points[[1]], [2.0, 10.0]), [0.1], atol=1e-15)
+    steep = np.array([[0.0, 0.0], [1.0, 100.0]])
+    assert path_distance(steep, np.array([[0.99, 100.0]]), [1.0, 100.0])[0] < 0.01
 
 
 # -- singular models ------------------------------------------------------------------------

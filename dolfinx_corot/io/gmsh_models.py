@@ -54,7 +54,8 @@ def cylinder_eighth(radius: float, length: float, n_theta: int, n_x: int,
 
     x ∈ [0, length/2], θ ∈ [0, 90°] measured from the z axis towards y. Groups:
     'shell' (surface), 'mid' (edge on x = 0), 'top' (edge on y = 0), 'side'
-    (edge on z = 0), points 'A' (0, 0, R), 'B' (L/2, 0, R), 'C' (L/2, R, 0).
+    (edge on z = 0), points 'A' (0, 0, R), 'B' (L/2, 0, R), 'C' (L/2, R, 0), 'D' (0, R, 0)
+    (Sze, Liu & Lo (2004, §3.5) call D their point B).
     """
     import gmsh
 
@@ -76,7 +77,8 @@ def cylinder_eighth(radius: float, length: float, n_theta: int, n_x: int,
         if quads:
             gmsh.model.mesh.setRecombine(2, surface)
         for dim, tags, tag, name in ((2, [surface], 1, "shell"), (1, [mid], 2, "mid"), (1, [top], 3, "top"),
-                                     (1, [side], 4, "side"), (0, [A], 5, "A"), (0, [B], 6, "B"), (0, [C], 7, "C")):
+                                     (1, [side], 4, "side"), (0, [A], 5, "A"), (0, [B], 6, "B"), (0, [C], 7, "C"),
+                                     (0, [D], 8, "D")):
             gmsh.model.addPhysicalGroup(dim, tags, tag)
             gmsh.model.setPhysicalName(dim, tag, name)
         gmsh.model.mesh.generate(2)

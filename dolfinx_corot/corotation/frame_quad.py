@@ -43,17 +43,27 @@ H = 1e-30  # complex step of the frame spin's variation
 
 
 @numba.njit(cache=True)
-def frame(x, R):
-    """Element frame R (3, 3) (columns e₁, e₂, e₃) of the four points x (4, 3)."""
-    dt = x.dtype
+def diagonals(x):
+    """(d₁, d₂, n, |n|, l₁, l₂, ĥ₁, ĥ₂, m, |m|) of the four points x (4, 3): the diagonals
+    d₁ = x₃ − x₁, d₂ = x₄ − x₂, their lengths and directions, n = d₁ × d₂ and the bisector
+    m = ĥ₁ − ĥ₂ (real or complex, as x)."""
     d1 = x[2] - x[0]
     d2 = x[3] - x[1]
-    n = np.empty(3, dtype=dt)
+    n = np.empty(3, dtype=x.dtype)
     cross(d1, d2, n)
-    e3 = n / np.sqrt(dot(n, n))
-    m = d1 / np.sqrt(dot(d1, d1)) - d2 / np.sqrt(dot(d2, d2))
-    e1 = m / np.sqrt(dot(m, m))
-    frame_axes(e1, e3, R)
+    l1 = np.sqrt(dot(d1, d1))
+    l2 = np.sqrt(dot(d2, d2))
+    h1 = d1 / l1
+    h2 = d2 / l2
+    m = h1 - h2
+    return d1, d2, n, np.sqrt(dot(n, n)), l1, l2, h1, h2, m, np.sqrt(dot(m, m))
+
+
+@numba.njit(cache=True)
+def frame(x, R):
+    """Element frame R (3, 3) (columns e₁, e₂, e₃) of the four points x (4, 3)."""
+    _, _, n, nn, _, _, _, _, m, mm = diagonals(x)
+    frame_axes(m / mm, n / nn, R)
 
 
 @numba.njit(cache=True)
@@ -68,25 +78,15 @@ def basic(X, u, xbar0, dbar, B):
     """In-plane deformational displacements dbar (8,) = (ū_a, v̄_a) and B = ∂d̄/∂u (8, 12)."""
     dt = u.dtype
     x = positions(X, u)
+    d1, d2, n, nn, l1, l2, h1, h2, m, mm = diagonals(x)
     R = np.empty((3, 3), dtype=dt)
-    frame(x, R)
+    frame_axes(m / mm, n / nn, R)
     xbar = np.empty((4, 3), dtype=dt)
     local_coordinates(R, x, xbar)
     for a in range(4):
         dbar[2 * a] = xbar[a, 0] - xbar0[a, 0]
         dbar[2 * a + 1] = xbar[a, 1] - xbar0[a, 1]
     # frame spin ω (3, 12) in terms of the global δu
-    d1 = x[2] - x[0]
-    d2 = x[3] - x[1]
-    n = np.empty(3, dtype=dt)
-    cross(d1, d2, n)
-    nn = np.sqrt(dot(n, n))
-    l1 = np.sqrt(dot(d1, d1))
-    l2 = np.sqrt(dot(d2, d2))
-    h1 = d1 / l1
-    h2 = d2 / l2
-    m = h1 - h2
-    mm = np.sqrt(dot(m, m))
     e1 = R[:, 0].copy()
     e2 = R[:, 1].copy()
     # e·δn = e·(δd1 × d2) + e·(d1 × δd2) = (d2 × e)·δd1 + (e × d1)·δd2
@@ -222,17 +222,7 @@ def shape_spin_derivative(y, v, J):
     δn = δd₁ × d₂ + d₁ × δd₂, δe₃ = (I − e₃e₃ᵀ)δn/|n|, δm = P₁δd₁/l₁ − P₂δd₂/l₂,
     δe₁ = (I − e₁e₁ᵀ)δm/|m|, δe₂ = δe₃ × e₁ + e₃ × δe₁. Tested against the complex-step derivative
     of :func:`shape_spin`."""
-    d1 = y[2] - y[0]
-    d2 = y[3] - y[1]
-    n = np.empty(3)
-    cross(d1, d2, n)
-    nn = np.sqrt(dot(n, n))
-    l1 = np.sqrt(dot(d1, d1))
-    l2 = np.sqrt(dot(d2, d2))
-    h1 = d1 / l1
-    h2 = d2 / l2
-    m = h1 - h2
-    mm = np.sqrt(dot(m, m))
+    d1, d2, n, nn, l1, l2, h1, h2, m, mm = diagonals(y)
     e1 = m / mm
     e3 = n / nn
     e2 = np.empty(3)

@@ -142,9 +142,11 @@ def three_meshes(demo):
                 curves[membrane] = curve
             d = distances(curve)
             k = int(np.argmin(np.abs(curve[:, 1] - W_CHECK)))
-            falls = np.flatnonzero(np.diff(np.r_[0.0, curve[:, 0]]) < 0.0)  # steps where P falls as w_A grows
+            P0 = np.r_[0.0, curve[:, 0]]  # from the unloaded state
+            falls = np.flatnonzero(np.diff(P0) < 0.0)  # steps k where P falls as w_A grows (to curve[k])
             outside = int(np.sum(np.abs(curve[falls, 1] - SNAP) > 0.05))
-            fall = max([0.0] + [1.0 - curve[k, 0] / curve[k - 1, 0] for k in falls])
+            # a fall relative to the force before it (a first step that pulls back counts as a whole fall)
+            fall = max([0.0] + [(P0[k] - P0[k + 1]) / max(abs(P0[k]), P0[k] - P0[k + 1]) for k in falls])
             rows.append((n_theta, n_x, d[band].max(), d.max(), *d.max(axis=0), curve[k, 0], wall,
                          res.totals["newton_iterations"], res.totals["cuts"], curve[-1, 0], outside, fall))
             demo.say(f"{FAMILY[membrane]:>22s} {n_theta:2d} x {n_x:2d}: distance from Sze's table up to "

@@ -345,11 +345,20 @@ def path_distance(path: np.ndarray, points: np.ndarray, scale) -> np.ndarray:
 
     Where a curve is steep, a difference of loads at equal displacement (or the reverse)
     magnifies small offsets; the distance from the polyline does not."""
-    a = np.asarray(path, dtype=float)[:-1] / scale
-    d = np.asarray(path, dtype=float)[1:] / scale - a
+    path, points, scale = (np.asarray(v, dtype=float) for v in (path, points, scale))
+    if path.ndim != 2 or len(path) < 2:
+        raise ValueError(f"path_distance: the path needs at least two states as rows (n, k), not shape {path.shape}")
+    k = path.shape[1]
+    if points.ndim != 2 or points.shape[1] != k or scale.shape != (k,):
+        raise ValueError(f"path_distance: the points {points.shape} and the scale {scale.shape} need the path's "
+                         f"{k} coordinates per row")
+    if not np.all(scale > 0.0):
+        raise ValueError(f"path_distance: every scale must be positive, not {scale.tolist()}")
+    a = path[:-1] / scale
+    d = path[1:] / scale - a
     dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
     out = np.empty(len(points))
-    for i, q in enumerate(np.asarray(points, dtype=float) / scale):
+    for i, q in enumerate(points / scale):
         s = np.clip(np.einsum("ij,ij->i", q - a, d) / dd, 0.0, 1.0)
         out[i] = np.min(np.linalg.norm(a + s[:, None] * d - q, axis=1))
     return out

@@ -219,7 +219,8 @@ def test_path_distance_of_reference_points():
     """The distance of points from a traced path (a polyline) after scaling each coordinate: a
     point on a segment is at 0, one off a vertical segment at its horizontal offset, one beyond
     the end at its distance from the last state; on a steep segment the distance stays small
-    where a difference of loads at equal displacement is large."""
+    where a difference of loads at equal displacement is large. A path of one state, points or
+    scales of another width and a scale that is not positive are refused by name."""
     path = np.array([[0.0, 0.0], [1.0, 1.0], [1.0, 3.0]])
     points = np.array([[0.5, 0.5], [1.2, 2.0], [1.0, 4.0], [0.0, 1.0]])
     d = path_distance(path, points, [1.0, 1.0])
@@ -228,6 +229,14 @@ def test_path_distance_of_reference_points():
     np.testing.assert_allclose(path_distance(path, points[[1]], [2.0, 10.0]), [0.1], atol=1e-15)
     steep = np.array([[0.0, 0.0], [1.0, 100.0]])
     assert path_distance(steep, np.array([[0.99, 100.0]]), [1.0, 100.0])[0] < 0.01
+    with pytest.raises(ValueError, match="at least two states"):
+        path_distance(path[:1], points, [1.0, 1.0])
+    with pytest.raises(ValueError, match="need the path's 2 coordinates"):
+        path_distance(path, points[:, :1], [1.0, 1.0])
+    with pytest.raises(ValueError, match="need the path's 2 coordinates"):
+        path_distance(path, points, [1.0])
+    with pytest.raises(ValueError, match="must be positive"):
+        path_distance(path, points, [1.0, 0.0])
 
 
 # -- singular models ------------------------------------------------------------------------

@@ -154,6 +154,17 @@ def test_restart_under_mpi_matches_serial(tmp_path):
     np.testing.assert_allclose(runs[2]["tip"], runs[1]["tip"], atol=1e-8)
 
 
+# pytest's closing summary, e.g. "42 passed, 1 skipped in 62.63s" (+ " (0:01:02)" past a minute)
+_SUMMARY = re.compile(r"(?:\d+ (?:failed|passed|skipped|errors?|warnings?|deselected|xfailed|xpassed)(?:, )?)+"
+                      r" in [\d.]+s(?: \([\d:]+\))?")
+
+
+def _pytest_summaries(out: str) -> list[str]:
+    """The closing summaries of the ranks' pytest runs in ``out``: found anywhere, since two
+    ranks writing at once can put both on one line ("43 passed in 29.27s43 passed in 29.28s")."""
+    return _SUMMARY.findall(out)
+
+
 @pytest.mark.mpi
 def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
     """Parts on several meshes (shared nodes across ranks), quadrilateral membranes, continua
@@ -177,8 +188,7 @@ def test_coupled_parts_and_quad_membranes_under_mpi(tmp_path):
                 "tests/test_loads.py", "tests/test_plot.py", "tests/test_console.py", "tests/test_element_results.py",
                 "tests/test_symmetrized_tangent.py"],
                tmp_path)
-    # pytest's closing line on each rank: "N passed, M skipped in 62.63s" (+ " (0:01:02)" past a minute)
-    summaries = [line for line in out.splitlines() if re.search(r"\d+ passed.* in [\d.]+s( \([\d:]+\))?\s*$", line)]
+    summaries = _pytest_summaries(out)
     assert len(summaries) == 2, out[-3000:]
     assert not any("failed" in line or "error" in line for line in summaries), summaries
 
@@ -193,6 +203,6 @@ def test_quadrilateral_shells_and_laminates_under_mpi(tmp_path):
     per_rank = f'PYTEST_DEBUG_TEMPROOT="{tmp_path}/rank$OMPI_COMM_WORLD_RANK" exec "$@"'
     out = _run(["mpirun", "-n", "2", "sh", "-c", per_rank, "sh", sys.executable, "-m", "pytest", "-q", "-p",
                 "no:cacheprovider", "--color=no", "tests/test_shell_quad.py", "tests/test_laminates.py"], tmp_path)
-    summaries = [line for line in out.splitlines() if re.search(r"\d+ passed.* in [\d.]+s( \([\d:]+\))?\s*$", line)]
+    summaries = _pytest_summaries(out)
     assert len(summaries) == 2, out[-3000:]
     assert not any("failed" in line or "error" in line for line in summaries), summaries

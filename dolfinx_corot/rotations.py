@@ -388,8 +388,16 @@ def quat_update(q, dtheta):
 @numba.njit(cache=True)
 def quat_to_matrix(q):
     """Rotation tensor (3, 3) of the unit quaternion ``q`` (4,)."""
-    w, x, y, z = q[0], q[1], q[2], q[3]
     R = np.empty((3, 3))
+    quat_to_matrix_into(q, R)
+    return R
+
+
+@numba.njit(cache=True, inline="always")
+def quat_to_matrix_into(q, R):
+    """R (3, 3) = the rotation tensor of the unit quaternion ``q`` (4,), in place (element kernels:
+    no allocation)."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
     R[0, 0] = 1.0 - 2.0 * (y * y + z * z)
     R[0, 1] = 2.0 * (x * y - w * z)
     R[0, 2] = 2.0 * (x * z + w * y)
@@ -399,7 +407,6 @@ def quat_to_matrix(q):
     R[2, 0] = 2.0 * (x * z - w * y)
     R[2, 1] = 2.0 * (y * z + w * x)
     R[2, 2] = 1.0 - 2.0 * (x * x + y * y)
-    return R
 
 
 @numba.njit(cache=True)

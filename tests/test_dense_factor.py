@@ -51,6 +51,43 @@ def test_inertia_sign_and_solution_of_random_matrices():
         assert np.linalg.norm(K @ x.array - b.array) <= 1e-9 * np.linalg.norm(K) * np.linalg.norm(x.array)
 
 
+def test_band_lu_equals_the_dense_lu():
+    """Band matrices (the tangents of chains numbered along them) go to LAPACK's band LU: the sign
+    of the determinant, the null pivots and the solution equal numpy's and the dense LU's, with
+    pivoting needed (zero diagonal entries) and without, and for unequal bandwidths."""
+    rng = np.random.default_rng(3)
+    banded = 0
+    for trial in range(200):
+        n = int(rng.integers(8, 60))
+        pivoting = trial % 3 == 0  # (a zero diagonal needs a band off the diagonal to stay regular)
+        kl, ku = int(rng.integers(pivoting, 4)), int(rng.integers(pivoting, 4))
+        i, j = np.indices((n, n))
+        K = np.where((i - j <= kl) & (j - i <= ku), rng.normal(size=(n, n)), 0.0)
+        if pivoting:
+            K[np.arange(0, n, 3), np.arange(0, n, 3)] = 0.0
+        if not pivoting:
+            K += 4.0 * np.sign(rng.normal(size=n)) * np.eye(n)  # regular, either sign on the diagonal
+        elif abs(np.linalg.slogdet(K)[1]) > 100.0:
+            continue  # (a zero diagonal with a narrow band may be singular)
+        f, g = DenseFactor(_matrix(K)), DenseFactor(_matrix(K))
+        g.band = False
+        f.factorize(False)
+        g.factorize(False)
+        banded += f._band is not None and g._band is None
+        assert f.sign == g.sign == np.sign(np.linalg.det(K)) and f.null_pivots == g.null_pivots == 0, trial
+        b = PETSc.Vec().createSeq(n)
+        b.array[:] = rng.normal(size=n)
+        x = b.duplicate()
+        f.solve(b, x)
+        assert np.linalg.norm(K @ x.array - b.array) <= 1e-9 * np.linalg.norm(K) * np.linalg.norm(x.array), trial
+    assert banded >= 150
+    # a singular band (a free chain of three bars): one null pivot, as the dense LU finds
+    chain = np.diag([1.0, 2.0, 2.0, 2.0, 2.0, 2.0, 1.0]) - np.eye(7, k=1) - np.eye(7, k=-1)
+    f = DenseFactor(_matrix(chain))
+    f.factorize(False)
+    assert f._band == (1, 1) and f.null_pivots == 1
+
+
 @pytest.mark.parametrize("scale", [1.0, 1e9])
 def test_a_singular_matrix_has_a_null_pivot(scale):
     """A free bar (a rigid translation) whatever the stiffness's units: one null pivot both ways."""

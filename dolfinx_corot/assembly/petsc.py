@@ -118,7 +118,7 @@ NULL_PIVOT = 1e-13  # a pivot of K scaled to a unit diagonal below this is null
 
 
 class DenseFactor:
-    """LU (LAPACK dgetrf) of a small serial PETSc matrix, with LDLᵀ (Bunch–Kaufman, dsytrf)
+    """LU (LAPACK: dgetrf, or dgbtrf for a narrow band) of a small serial PETSc matrix, with LDLᵀ (Bunch–Kaufman, dsytrf)
     for the inertia of a symmetric one.
 
     negative: negative eigenvalues (Sylvester: the negative eigenvalues of the 1 × 1 and
@@ -136,23 +136,17 @@ class DenseFactor:
         self.negative = 0
         self.sign = 1
         self.null_pivots = 0
-        self._flat: tuple | None = None
+        self._band: tuple | None = None  # (kl, ku) of a band factorization
+        self.band = True  # narrow bands by the band LU
 
     def _dense(self) -> np.ndarray:
         """The matrix scaled to a unit diagonal, S K S (as MUMPS scales: pivots compare with 1;
-        congruence keeps the inertia and the determinant's sign); sets S."""
+        congruence keeps the inertia and the determinant's sign), in LAPACK's (column) order; sets S."""
+        from . import dense
         indptr, indices, values = self.A.getValuesCSR()
-        if self._flat is None or self._flat[0].shape != indptr.shape or not (
-                np.array_equal(self._flat[0], indptr) and np.array_equal(self._flat[1], indices)):
-            # positions of the stored entries in the dense array, kept while the sparsity is
-            rows = np.repeat(np.arange(self.n), np.diff(indptr))
-            self._flat = (indptr.copy(), indices.copy(), rows * self.n + indices)
-        K = np.zeros((self.n, self.n))
-        K.ravel()[self._flat[2]] = values
-        diag = np.abs(np.diag(K))
-        self._s = 1.0 / np.sqrt(np.where(diag > 0.0, diag, 1.0))
-        K *= self._s[:, None]
-        K *= self._s[None, :]
+        K = np.empty((self.n, self.n), order="F")
+        self._s = np.empty(self.n)
+        dense.scaled_dense(values, indptr, indices, K, self._s)
         return K
 
     def _ldlt_inertia(self, K: np.ndarray) -> tuple[int, int]:
@@ -160,7 +154,9 @@ class DenseFactor:
         f, piv, info = self._lapack.dsytrf(K, lower=1)
         if info < 0:
             raise np.linalg.LinAlgError(f"LAPACK dsytrf failed (info {info})")
-        d = np.diag(f)
+        d = f.diagonal()
+        if piv.min() > 0:  # 1 × 1 blocks alone: D's diagonal
+            return int(np.count_nonzero(d < 0.0)), int(np.count_nonzero(np.abs(d) <= NULL_PIVOT))
         off = np.append(np.diag(f, -1), 0.0)
         # 2 × 2 blocks of D: negative ipiv entries, in pairs (k, k + 1) from the start of each
         # run of them (LAPACK; consecutive blocks may share the value)
@@ -180,19 +176,34 @@ class DenseFactor:
         if state == self._state:
             return
         self._state = state
-        K = self._dense()
         self.ldlt = ldlt
-        # solves by LU (this SciPy has no dsytrs); the inertia from Bunch–Kaufman's D
-        self._f, self._piv, info = self._lapack.dgetrf(K)
-        if info < 0:
-            raise np.linalg.LinAlgError(f"LAPACK dgetrf failed (info {info})")
-        if ldlt:
-            self.negative, self.null_pivots = self._ldlt_inertia(K)
+        from . import dense
+        indptr, indices, values = self.A.getValuesCSR()
+        kl, ku = dense.bandwidths(indptr, indices)
+        self._s = np.empty(self.n)
+        if not ldlt and self.band and 3 * kl * (kl + ku) < self.n * self.n:
+            # a band (a chain of elements numbered along it: the 45° bend's 54 dofs, kl = ku = 11):
+            # LAPACK's band LU, the same partial pivoting (the column below a pivot holds no entry
+            # outside the band) for a fraction of the dense work
+            ab = np.empty((2 * kl + ku + 1, self.n), order="F")
+            dense.scaled_band(values, indptr, indices, kl, ku, ab, self._s)
+            self._f, self._piv, info = self._lapack.dgbtrf(ab, kl, ku, overwrite_ab=1)
+            self._band = (kl, ku)
+            pivots = self._f[kl + ku]
         else:
-            u = np.diag(self._f)
-            swaps = int(np.sum(self._piv != np.arange(self.n)))
-            self.null_pivots = int(np.sum(np.abs(u) <= NULL_PIVOT))
-            self.sign = (-1) ** (swaps + int(np.sum(u < 0.0)))
+            # solves by LU (this SciPy has no dsytrs); the inertia from Bunch–Kaufman's D
+            K = np.empty((self.n, self.n), order="F")  # (LAPACK's order: factorized in place)
+            dense.scaled_dense(values, indptr, indices, K, self._s)
+            self._f, self._piv, info = self._lapack.dgetrf(K, overwrite_a=not ldlt)
+            self._band = None
+            pivots = self._f.diagonal()
+            if ldlt and info >= 0:
+                self.negative, self.null_pivots = self._ldlt_inertia(K)
+        if info < 0:
+            raise np.linalg.LinAlgError(f"LAPACK LU failed (info {info})")
+        if not ldlt:
+            swaps, self.null_pivots, negative = dense.lu_summary(pivots, self._piv, NULL_PIVOT)
+            self.sign = (-1) ** (swaps + negative)
 
     def symmetric_inertia(self) -> int:
         """Negative eigenvalues of ½(K + Kᵀ) of the current matrix (−1: singular); the factors
@@ -202,7 +213,10 @@ class DenseFactor:
         return -1 if null else negative
 
     def solve(self, rhs: PETSc.Vec, out: PETSc.Vec) -> None:
-        x, info = self._lapack.dgetrs(self._f, self._piv, self._s * rhs.array_r)
+        if self._band is not None:
+            x, info = self._lapack.dgbtrs(self._f, *self._band, self._s * rhs.array_r, self._piv)
+        else:
+            x, info = self._lapack.dgetrs(self._f, self._piv, self._s * rhs.array_r)
         out.array[:] = self._s * x
 
 

@@ -123,6 +123,7 @@ class System:
         has_forms = any(f is not None for f in self._follower_forms)
         self.fload = petsc.duplicate(self.b) if (self._load_contributions or has_forms) else None
         self._version = 0          # counts changes of the configuration
+        self._residual_at = None   # (configuration, load factor) of the last residual
         self._tangent_version = -1  # the configuration of a tangent assembled ahead (tangent_at)
         self.C: PETSc.Mat | None = None   # the contributions' matrix over their declared couplings
         self._merged = False
@@ -280,15 +281,7 @@ class System:
         self.fext_total.copy(self.b)
         self.b.axpy(-1.0, self.fint)
         self._constrain_residual(load_factor)
-        squares = np.zeros(6)
-        for k, v in enumerate((self.b, self.fext_total, self.fint)):
-            a = v.array
-            if a.size and not np.abs(a).max() < 1e150:
-                with np.errstate(over="ignore"):  # loads beyond floating point: an infinite norm, reported
-                    squares[2 * k: 2 * k + 2] = np.bincount(self._field, a * a, 2)
-            else:
-                squares[2 * k: 2 * k + 2] = np.bincount(self._field, a * a, 2)
-        squares = self._reduce(squares, MPI.SUM)
+        squares = self._reduce(self._field_squares((self.b, self.fext_total, self.fint)), MPI.SUM)
         norm = math.sqrt(squares[0] + squares[1])
         ref = max(math.sqrt(squares[2] + squares[3]), math.sqrt(squares[4] + squares[5]))
         # per field (forces; moments on rotational dofs), each against its own scale
@@ -300,7 +293,18 @@ class System:
             self.fields = {"force": (math.sqrt(squares[0]), max(ref_f, ref_m / ell if ell > 0.0 else 0.0)),
                            "moment": (math.sqrt(squares[1]), max(ref_m, ell * ref_f))}
         self.timings.assembly += time.perf_counter() - t
+        self._residual_at = (self._version, load_factor)
         return norm, ref
+
+    def _field_squares(self, vectors) -> np.ndarray:
+        """Σ a² over the owned entries of each vector, per field: [v₀ force, v₀ moment, v₁ force, …]."""
+        A = self._squares_buffer[: len(vectors)]
+        for k, v in enumerate(vectors):
+            A[k] = v.array_r
+        if A.size and not np.abs(A).max() < 1e150:
+            with np.errstate(over="ignore"):  # loads beyond floating point: an infinite norm, reported
+                return np.concatenate([np.bincount(self._field, a * a, 2) for a in A])
+        return ((A * A) @ self._membership).ravel()  # (one product for all: small systems)
 
     def _reduce(self, value, op):
         """``comm.allreduce`` of the Newton loop's small values; on one rank the value itself
@@ -319,6 +323,8 @@ class System:
         """Which dofs carry moments; the model's length and coordinate scales (round-off floor)."""
         self._rot = self._rotation_mask()
         self._field = self._rot.astype(np.intp)  # 0: force, 1: moment
+        self._membership = np.stack([~self._rot, self._rot], axis=1).astype(float)  # (owned, 2)
+        self._squares_buffer = np.empty((3, len(self._rot)))
         self.has_rotations = bool(self.comm.allreduce(int(self._rot.any()), op=MPI.MAX))
         lo, hi = [], []
         for m in self.models:
@@ -375,9 +381,7 @@ class System:
 
     def correction_norms(self) -> dict[str, tuple[float, float]]:
         """Per field: (‖dx‖, ‖Σ corrections of the step‖) — translations, rotations."""
-        a, b = self.dx.array, self.step_dx.array
-        sq = np.concatenate([np.bincount(self._field, a * a, 2), np.bincount(self._field, b * b, 2)])
-        sq = np.sqrt(self._reduce(sq, MPI.SUM))
+        sq = np.sqrt(self._reduce(self._field_squares((self.dx, self.step_dx)), MPI.SUM))
         out = {"force": (sq[0], sq[2])}
         if self.has_rotations:
             out["moment"] = (sq[1], sq[3])
@@ -594,7 +598,8 @@ class System:
         """Assemble (and, with a direct solver, factorize) the tangent at the current configuration,
         its contributions evaluated there; the next Newton solve from here uses it as it is."""
         self._tangent_version = -1
-        self.residual(load_factor)
+        if self.contributions or self._residual_at != (self._version, load_factor):
+            self.residual(load_factor)  # (parts alone: the last residual, at this very state, will do)
         self.jacobian()
         self._tangent_version = self._version
         if factorize:
@@ -693,6 +698,7 @@ class System:
     def before_step(self) -> None:
         """A load step (or its retry) starts: the contributions' hook, and the sum of its corrections
         from 0 (see :meth:`step_increment_norm`)."""
+        self._residual_at = None  # (a stage's change of the elements does not count as a new configuration)
         for c in self.contributions:
             c.before_step()
         with self.step_dx.localForm() as s:

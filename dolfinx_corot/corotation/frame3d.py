@@ -56,17 +56,19 @@ def initial_frame(X1, X2, v, R0):
     Returns l0; raises nothing: a v parallel to the element is caught when the
     part is built (see ``check_orientation``).
     """
-    d = X2 - X1
-    l0 = np.sqrt(dot(d, d))
-    e1 = d / l0
-    e2 = v - dot(v, e1) * e1
-    e2 = e2 / np.sqrt(dot(e2, e2))
-    e3 = np.empty(3)
-    cross(e1, e2, e3)
-    for i in range(3):
-        R0[i, 0] = e1[i]
-        R0[i, 1] = e2[i]
-        R0[i, 2] = e3[i]
+    # (scalars: an element kernel allocates nothing here)
+    d0, d1, d2 = X2[0] - X1[0], X2[1] - X1[1], X2[2] - X1[2]
+    l0 = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    a0, a1, a2 = d0 / l0, d1 / l0, d2 / l0
+    va = v[0] * a0 + v[1] * a1 + v[2] * a2
+    b0, b1, b2 = v[0] - va * a0, v[1] - va * a1, v[2] - va * a2
+    nb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+    b0, b1, b2 = b0 / nb, b1 / nb, b2 / nb
+    R0[0, 0], R0[1, 0], R0[2, 0] = a0, a1, a2
+    R0[0, 1], R0[1, 1], R0[2, 1] = b0, b1, b2
+    R0[0, 2] = a1 * b2 - a2 * b1
+    R0[1, 2] = a2 * b0 - a0 * b2
+    R0[2, 2] = a0 * b1 - a1 * b0
     return l0
 
 
@@ -74,25 +76,26 @@ def initial_frame(X1, X2, v, R0):
 def current_frame(X1, X2, u1, u2, R1, R2, R0, Rr, p1, p2):
     """The current element frame Rr (3, 3) (columns e1, e2, e3) and p1, p2 (3,) = R_i R0 j;
     returns the current length l."""
-    dt = u1.dtype
-    dx = np.empty(3, dtype=dt)
-    for k in range(3):
-        dx[k] = X2[k] + u2[k] - X1[k] - u1[k]
-    l = np.sqrt(dot(dx, dx))
-    e1 = dx / l
+    # (scalars: an element kernel allocates nothing here)
+    x0 = X2[0] + u2[0] - X1[0] - u1[0]
+    x1 = X2[1] + u2[1] - X1[1] - u1[1]
+    x2 = X2[2] + u2[2] - X1[2] - u1[2]
+    l = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
+    a0, a1, a2 = x0 / l, x1 / l, x2 / l
     for k in range(3):
         p1[k] = R1[k, 0] * R0[0, 1] + R1[k, 1] * R0[1, 1] + R1[k, 2] * R0[2, 1]
         p2[k] = R2[k, 0] * R0[0, 1] + R2[k, 1] * R0[1, 1] + R2[k, 2] * R0[2, 1]
-    p = 0.5 * (p1 + p2)
-    e3 = np.empty(3, dtype=dt)
-    cross(e1, p, e3)
-    e3 = e3 / np.sqrt(dot(e3, e3))
-    e2 = np.empty(3, dtype=dt)
-    cross(e3, e1, e2)
-    for k in range(3):
-        Rr[k, 0] = e1[k]
-        Rr[k, 1] = e2[k]
-        Rr[k, 2] = e3[k]
+    q0, q1, q2 = 0.5 * (p1[0] + p2[0]), 0.5 * (p1[1] + p2[1]), 0.5 * (p1[2] + p2[2])
+    c0 = a1 * q2 - a2 * q1
+    c1 = a2 * q0 - a0 * q2
+    c2 = a0 * q1 - a1 * q0
+    nc = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+    c0, c1, c2 = c0 / nc, c1 / nc, c2 / nc
+    Rr[0, 0], Rr[1, 0], Rr[2, 0] = a0, a1, a2
+    Rr[0, 1] = c1 * a2 - c2 * a1
+    Rr[1, 1] = c2 * a0 - c0 * a2
+    Rr[2, 1] = c0 * a1 - c1 * a0
+    Rr[0, 2], Rr[1, 2], Rr[2, 2] = c0, c1, c2
     return l
 
 
@@ -119,12 +122,10 @@ def frame_and_basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B, Rr, p1, p2, GT,
     Gᵀ (3, 12) in local components and T⁻¹(θ̄_i) (2, 3, 3); returns (ū, l)."""
     dt = u1.dtype
     l = current_frame(X1, X2, u1, u2, R1, R2, R0, Rr, p1, p2)
-    p = 0.5 * (p1 + p2)
-    e1 = Rr[:, 0].copy()
-    e2 = Rr[:, 1].copy()
-    T = np.empty((3, 3), dtype=dt)
-    Rb = np.empty((3, 3), dtype=dt)
-    R0c = np.empty((3, 3), dtype=dt)
+    work = np.empty((3, 3, 3), dtype=dt)  # (one allocation: T, R_r^T R_i R_0, R_0 in the dtype)
+    T = work[0]
+    Rb = work[1]
+    R0c = work[2]
     for i in range(3):
         for j in range(3):
             R0c[i, j] = R0[i, j]
@@ -135,17 +136,18 @@ def frame_and_basic(X1, X2, u1, u2, R1, R2, R0, l0, th1, th2, B, Rr, p1, p2, GT,
     matmul3(T, R0c, Rb)
     log_so3(Rb, th2)
     ubar = (l * l - l0 * l0) / (l + l0)
-    # local components of p, p1, p2 (only the first two are needed)
-    pl0 = dot(e1, p)
-    pl1 = dot(e2, p)
+    # local components of p, p1, p2 (only the first two are needed); e1, e2 the columns of Rr
+    q0, q1, q2 = 0.5 * (p1[0] + p2[0]), 0.5 * (p1[1] + p2[1]), 0.5 * (p1[2] + p2[2])
+    pl0 = Rr[0, 0] * q0 + Rr[1, 0] * q1 + Rr[2, 0] * q2
+    pl1 = Rr[0, 1] * q0 + Rr[1, 1] * q1 + Rr[2, 1] * q2
     eta = pl0 / pl1
     GT[:, :] = 0.0
     GT[0, 2] = eta / l
-    GT[0, 3] = 0.5 * dot(e2, p1) / pl1
-    GT[0, 4] = -0.5 * dot(e1, p1) / pl1
+    GT[0, 3] = 0.5 * (Rr[0, 1] * p1[0] + Rr[1, 1] * p1[1] + Rr[2, 1] * p1[2]) / pl1
+    GT[0, 4] = -0.5 * (Rr[0, 0] * p1[0] + Rr[1, 0] * p1[1] + Rr[2, 0] * p1[2]) / pl1
     GT[0, 8] = -eta / l
-    GT[0, 9] = 0.5 * dot(e2, p2) / pl1
-    GT[0, 10] = -0.5 * dot(e1, p2) / pl1
+    GT[0, 9] = 0.5 * (Rr[0, 1] * p2[0] + Rr[1, 1] * p2[1] + Rr[2, 1] * p2[2]) / pl1
+    GT[0, 10] = -0.5 * (Rr[0, 0] * p2[0] + Rr[1, 0] * p2[1] + Rr[2, 0] * p2[2]) / pl1
     GT[1, 2] = 1.0 / l
     GT[1, 8] = -1.0 / l
     GT[2, 1] = -1.0 / l
@@ -189,28 +191,32 @@ def add_geometric_stiffness(l, Rr, p1, p2, GT, Ti, th1, th2, B, fbar, K):
 
     Arguments from :func:`frame_and_basic` and the basic forces f̄ (7,); every term is exact, so
     K equals the complex-step derivative of f = Bᵀ f̄ to rounding (tested)."""
-    m = np.empty((2, 3))
+    # (few allocations: an element kernel's time goes largely into them otherwise)
+    v3 = np.empty((6, 3))
+    w12 = np.zeros((6, 12))
+    w312 = np.zeros((8, 3, 12))
+    m = v3[0:2]
     for i in range(2):
         for r in range(3):
             m[i, r] = Ti[i, 0, r] * fbar[1 + 3 * i] + Ti[i, 1, r] * fbar[2 + 3 * i] + Ti[i, 2, r] * fbar[3 + 3 * i]
-    ms = np.empty(3)
+    ms = v3[2]
     for r in range(3):
         ms[r] = m[0, r] + m[1, r]
-    fl = np.empty(12)
+    fl = w12[0]
     for c in range(12):
         fl[c] = -(GT[0, c] * ms[0] + GT[1, c] * ms[1] + GT[2, c] * ms[2])
     for k in range(3):
         fl[3 + k] += m[0, k]
         fl[9 + k] += m[1, k]
-    Om = np.empty((3, 12))
+    Om = w312[0]
     rotate_columns(GT, Rr, Om, 3, 12)
-    Wg = np.empty((3, 12))  # the frame's spin in global components per unit δd
+    Wg = w312[1]  # the frame's spin in global components per unit δd
     for k in range(3):
         for j in range(12):
             Wg[k, j] = Rr[k, 0] * Om[0, j] + Rr[k, 1] * Om[1, j] + Rr[k, 2] * Om[2, j]
     Z = np.zeros((12, 12))  # in local components, rotated to global rows at the end
     # K_h: (S_iᵀ − G) H_i B_θi
-    HBs = np.zeros((3, 12))
+    HBs = w312[2]
     Hi = np.empty((3, 3))
     for i in range(2):
         tangent_inv_so3_derivative(th1 if i == 0 else th2, fbar[1 + 3 * i:4 + 3 * i], Hi)
@@ -227,17 +233,20 @@ def add_geometric_stiffness(l, Rr, p1, p2, GT, Ti, th1, th2, B, fbar, K):
     # δE f_l
     subtract_spin_g_omega(Z, fl, Om, 12)
     # −δG m: gradients of e1, e2 (ω × e_k), p_i (δw_i × p_i), l
-    e1 = Rr[:, 0].copy()
-    e2 = Rr[:, 1].copy()
-    de1 = np.empty((3, 12))
-    de2 = np.empty((3, 12))
+    e1 = v3[3]
+    e2 = v3[4]
+    for k in range(3):
+        e1[k] = Rr[k, 0]
+        e2[k] = Rr[k, 1]
+    de1 = w312[3]
+    de2 = w312[4]
     for j in range(12):
         for e, de in ((e1, de1), (e2, de2)):
             de[0, j] = Wg[1, j] * e[2] - Wg[2, j] * e[1]
             de[1, j] = Wg[2, j] * e[0] - Wg[0, j] * e[2]
             de[2, j] = Wg[0, j] * e[1] - Wg[1, j] * e[0]
-    dp1 = np.zeros((3, 12))
-    dp2 = np.zeros((3, 12))
+    dp1 = w312[5]
+    dp2 = w312[6]
     for pi, dpi, c0 in ((p1, dp1, 3), (p2, dp2, 9)):
         # δw × p_i: column c0 + k is e_k × p_i
         dpi[1, c0] = -pi[2]
@@ -246,20 +255,24 @@ def add_geometric_stiffness(l, Rr, p1, p2, GT, Ti, th1, th2, B, fbar, K):
         dpi[2, c0 + 1] = -pi[0]
         dpi[0, c0 + 2] = -pi[1]
         dpi[1, c0 + 2] = pi[0]
-    p = 0.5 * (p1 + p2)
-    dp = 0.5 * (dp1 + dp2)
+    p = v3[5]
+    dp = w312[7]
+    for k in range(3):
+        p[k] = 0.5 * (p1[k] + p2[k])
+        for j in range(12):
+            dp[k, j] = 0.5 * (dp1[k, j] + dp2[k, j])
     P = dot(p, e2)
     Q = dot(p, e1)
-    dP = np.empty(12)
-    dQ = np.empty(12)
+    dP = w12[1]
+    dQ = w12[2]
     _grad_dot(p, dp, e2, de2, dP)
     _grad_dot(p, dp, e1, de1, dQ)
-    dinvl = np.zeros(12)  # ∇(1/l) = −r/l²
+    dinvl = w12[3]  # ∇(1/l) = −r/l²
     for k in range(3):
         dinvl[k] = e1[k] / (l * l)
         dinvl[6 + k] = -e1[k] / (l * l)
-    ds = np.empty(12)
-    dt_ = np.empty(12)
+    ds = w12[4]
+    dt_ = w12[5]
     for j in range(12):
         da0 = dQ[j] / (P * l) - Q / (P * P * l) * dP[j] + Q / P * dinvl[j]
         row2 = ms[0] * da0 + ms[1] * dinvl[j]

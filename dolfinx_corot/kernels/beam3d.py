@@ -54,18 +54,15 @@ def _force(X1, X2, u1, u2, R1, R2, R0, l0, props, f):
 def _corotational(X, S, props, f, K, tangent):
     """:func:`corotational` on the element's X (2, 3) and S (2, 7); K only if tangent: the closed
     form Bᵀ K̄ B + ∂Bᵀ/∂d : f̄ (:func:`~dolfinx_corot.corotation.frame3d.add_geometric_stiffness`)."""
-    R0 = np.empty((3, 3))
+    # (few allocations: an element kernel's time goes largely into them otherwise)
+    frames = np.empty((4, 3, 3))  # R0, Rr, the nodal rotations
+    vectors = np.empty((6, 3))    # θ̄1, θ̄2, p1, p2, u1, u2
+    rows = np.empty((10, 12))     # B, Gᵀ
+    R0, Rr, R = frames[0], frames[1], frames[2:]
+    th1, th2, p1, p2, u = vectors[0], vectors[1], vectors[2], vectors[3], vectors[4:]
+    B, GT = rows[:7], rows[7:]
     l0 = frame3d.initial_frame(X[0], X[1], props[law.VX:law.VZ + 1], R0)
-    u = np.empty((2, 3))
-    R = np.empty((2, 3, 3))
     nodal_states(S, u, R)
-    th1 = np.empty(3)
-    th2 = np.empty(3)
-    B = np.empty((7, 12))
-    Rr = np.empty((3, 3))
-    p1 = np.empty(3)
-    p2 = np.empty(3)
-    GT = np.empty((3, 12))
     Ti = np.empty((2, 3, 3))
     ubar, l = frame3d.frame_and_basic(X[0], X[1], u[0], u[1], R[0], R[1], R0, l0, th1, th2, B, Rr, p1, p2, GT, Ti)
     fbar = np.empty(7)

@@ -31,7 +31,7 @@ import numba
 import numpy as np
 
 from . import SYMMETRIZED  # noqa: F401 (the kernels' c[0] asking for symmetrize)
-from ..rotations import exp_so3, log_so3, matmul3, quat_mul, quat_to_matrix
+from ..rotations import exp_so3, log_so3, matmul3, quat_mul, quat_to_matrix, quat_to_matrix_into
 
 H = 1e-30  # complex step
 
@@ -66,7 +66,7 @@ def nodal_states(S, u, R):
     for a in range(S.shape[0]):
         for k in range(3):
             u[a, k] = S[a, k]
-        R[a] = quat_to_matrix(S[a, 3:7].copy())
+        quat_to_matrix_into(S[a, 3:7], R[a])
 
 
 @numba.njit(cache=True)

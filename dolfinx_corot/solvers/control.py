@@ -252,7 +252,8 @@ class LoadControl:
                 reached = abs(target - lam) <= 1e-14 * max(1.0, abs(target))
                 run.record(lam, report, cuts, started, extra,
                            position=index + (1.0 if reached else (lam - origin) / (target - origin)))
-                run.save({**self.describe(), "next_target": index + 1 if reached else index})
+                if run.checkpoint_path is not None:
+                    run.save({**self.describe(), "next_target": index + 1 if reached else index})
                 cuts = max(cuts - 1, 0)
         return run.result()
 

@@ -281,7 +281,8 @@ class Run:
             u = m.translations_of(np.arange(n))
             if u.size:
                 largest = max(largest, float(np.max(np.abs(u))) if np.all(np.isfinite(u)) else math.inf)
-        largest = self.system.comm.allreduce(largest, op=MPI.MAX)
+        if self.system.comm.size > 1:
+            largest = self.system.comm.allreduce(largest, op=MPI.MAX)
         size = self.model_size()
         if math.isfinite(largest) and largest <= limit * size:
             return None

@@ -10,6 +10,12 @@
   :mod:`dolfinx_corot.assembly.petsc` calls the two PETSc factories.
 * :func:`assemble_matrix_into`: a form's matrix added to an existing PETSc
   matrix through its current local-to-global map (no Dirichlet rows).
+* :func:`assemble_vector_into`, :func:`assemble_matrix_with_bcs`: DOLFINx's own assembly into
+  an existing vector or matrix, called as its Python layer calls it, without that layer's
+  dispatch (on a model of a few elements it costs as much as the kernels).
+* :func:`dirichletbc`: a Dirichlet condition on a subspace, given to DOLFINx as its C++ space
+  (given the Python one, DOLFINx 0.5.2 first fails a constructor whose error message prints
+  the dofs: 180 against 20 µs a condition).
 * :func:`function_space`: a Lagrange or DG function space whose C++ element is made once per
   process and element (DOLFINx 0.5.2 takes 10–100 ms to build one from its ufcx element,
   which every space made the public way pays again).
@@ -74,6 +80,30 @@ def petsc_matrix(comm, pattern):
 def petsc_vector(imap, block_size: int = 1):
     """A ghosted PETSc vector over an IndexMap."""
     return dolfinx.cpp.la.petsc.create_vector(imap, block_size)
+
+
+def assemble_vector_into(array: np.ndarray, form) -> None:
+    """array += the vector of ``form`` (local entries, owned and ghost), as
+    ``dolfinx.fem.petsc.assemble_vector`` does it."""
+    dolfinx.cpp.fem.assemble_vector(array, form, dolfinx.cpp.fem.pack_constants(form),
+                                    dolfinx.cpp.fem.pack_coefficients(form))
+
+
+def assemble_matrix_with_bcs(A, form, bcs: list, space) -> None:
+    """A += the matrix of ``form`` with the rows and columns of ``bcs`` zero and 1 on their
+    diagonal (``space``: the form's test space), as ``dolfinx.fem.petsc.assemble_matrix`` does
+    it; A is left to be assembled."""
+    dolfinx.cpp.fem.petsc.assemble_matrix(A, form, dolfinx.cpp.fem.pack_constants(form),
+                                          dolfinx.cpp.fem.pack_coefficients(form), bcs)
+    A.assemblyBegin(A.AssemblyType.FLUSH)
+    A.assemblyEnd(A.AssemblyType.FLUSH)
+    dolfinx.cpp.fem.petsc.insert_diagonal(A, space, bcs, 1.0)
+
+
+def dirichletbc(value, dofs, V: dolfinx.fem.FunctionSpace, comp: int):
+    """A Dirichlet condition on component ``comp`` of V (``dolfinx.fem.dirichletbc(value, dofs,
+    V.sub(comp))``, the subspace given as its C++ object)."""
+    return dolfinx.fem.dirichletbc(value, dofs, V.sub(comp)._cpp_object)
 
 
 def assemble_matrix_into(A, form) -> None:

@@ -35,6 +35,7 @@ from .contribution import Contribution
 from .layout import DofLayout
 
 logger = logging.getLogger(__name__)
+_EPS = float(np.finfo(float).eps)
 
 
 class Model(Protocol):
@@ -152,6 +153,7 @@ class System:
     # -- layout (one mesh: DOLFINx's own) -------------------------------------------
     def _build(self) -> None:
         self.L, self.a = self.model.forms()
+        self._test_space = self.a.function_spaces[0]
         self.bcs = self.model.dirichlet_bcs()
         self.A = petsc.form_matrix(self.a, self._mat_type)
         self.b = petsc.form_vector(self.L)
@@ -168,7 +170,7 @@ class System:
     def _assemble_parts(self) -> None:
         with self.fint.localForm() as f:
             f.set(0.0)
-        dolfinx.fem.petsc.assemble_vector(self.fint, self.L)
+            _dolfinx.assemble_vector_into(f.array_w, self.L)
         self.fint.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
 
     def _assemble_follower_forms(self) -> None:
@@ -325,7 +327,7 @@ class System:
         self._field = self._rot.astype(np.intp)  # 0: force, 1: moment
         self._membership = np.stack([~self._rot, self._rot], axis=1).astype(float)  # (owned, 2)
         self._squares_buffer = np.empty((3, len(self._rot)))
-        self.has_rotations = bool(self.comm.allreduce(int(self._rot.any()), op=MPI.MAX))
+        self.has_rotations = bool(self._reduce(int(self._rot.any()), MPI.MAX))
         lo, hi = [], []
         for m in self.models:
             X = m.V.mesh.geometry.x[:, : m.gdim]
@@ -352,7 +354,7 @@ class System:
             x = geometry.x[cells[:n_owned]]
             sides = np.linalg.norm(x - np.roll(x, 1, axis=1), axis=2)
             total += (sides.sum(), sides.size)
-        total = self.comm.allreduce(total, op=MPI.SUM)
+        total = self._reduce(total, MPI.SUM)
         self.element_length = float(total[0] / total[1]) if total[1] else self.length_scale
         self._coordinates = self._dof_coordinates()
         self._coordinates[self._rot] = 1.0
@@ -374,10 +376,10 @@ class System:
         if self._diagonal is None:
             self._diagonal = self.A.createVecLeft()
         self.A.getDiagonal(self._diagonal)
-        dc = self._diagonal.array * self._coordinates  # (rotations: coordinate 1)
-        eps = np.finfo(float).eps
-        sq = self._reduce(np.bincount(self._field, dc * dc, 2), MPI.SUM)
-        self.floors = {"force": eps * math.sqrt(sq[0]), "moment": eps * math.sqrt(sq[1])}
+        dc = self._diagonal.array_r * self._coordinates  # (rotations: coordinate 1)
+        dc *= dc
+        sq = self._reduce(dc @ self._membership, MPI.SUM)
+        self.floors = {"force": _EPS * math.sqrt(sq[0]), "moment": _EPS * math.sqrt(sq[1])}
 
     def correction_norms(self) -> dict[str, tuple[float, float]]:
         """Per field: (‖dx‖, ‖Σ corrections of the step‖) — translations, rotations."""
@@ -389,7 +391,7 @@ class System:
 
     def _assemble_parts_matrix(self) -> None:
         self.A.zeroEntries()
-        dolfinx.fem.petsc.assemble_matrix(self.A, self.a, bcs=self.bcs)
+        _dolfinx.assemble_matrix_with_bcs(self.A, self.a, self.bcs, self._test_space)
         self.A.assemble()
 
     def jacobian(self) -> None:
@@ -838,7 +840,7 @@ class System:
         """All constrained dofs (supports and prescribed motion), global numbering, on every rank."""
         own = [self.global_dofs(self.model, bc.dof_indices()[0][: bc.dof_indices()[1]]) for bc in self.bcs]
         own = np.concatenate(own) if own else np.zeros(0, dtype=np.int64)
-        return np.unique(np.concatenate(self.comm.allgather(own)))
+        return np.unique(own if self.comm.size == 1 else np.concatenate(self.comm.allgather(own)))
 
     def ownership_range(self) -> tuple[int, int]:
         return self.A.getOwnershipRange()
@@ -1094,7 +1096,7 @@ class CoupledSystem(System):
 
     def constrained_global_dofs(self) -> np.ndarray:
         own = (self._fixed + self.layout.start).astype(np.int64)
-        return np.unique(np.concatenate(self.comm.allgather(own)))
+        return np.unique(own if self.comm.size == 1 else np.concatenate(self.comm.allgather(own)))
 
     def ownership_range(self) -> tuple[int, int]:
         return self.layout.start, self.layout.start + self.layout.n_owned

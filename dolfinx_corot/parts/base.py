@@ -294,12 +294,6 @@ class Part:
         """Blocks whose non-translational dofs have no stiffness (fixed); none by default."""
         return np.zeros(0, dtype=np.int32)
 
-    def _subspace(self, comp: int):
-        """The C++ subspace of component ``comp``, as DOLFINx's DirichletBC takes it (given the
-        Python FunctionSpace, DOLFINx 0.5.2 first fails a constructor whose error message prints
-        the dofs: 180 against 20 µs a condition)."""
-        return self.V.sub(comp)._cpp_object
-
     def dirichlet_bcs(self) -> list:
         """Supports (zero), dofs without stiffness (zero) and prescribed displacements (their
         values at λ, see :meth:`set_load_factor`)."""
@@ -313,17 +307,18 @@ class Part:
                 if cond.holds:
                     holding.append((blocks * self.ndof + comp, comp))
                 else:
-                    bcs.append(dolfinx.fem.dirichletbc(zero, blocks * self.ndof + comp, self._subspace(comp)))
+                    bcs.append(_dolfinx.dirichletbc(zero, blocks * self.ndof + comp, self.V, comp))
         free = self._fixed_blocks()
         for comp in range(self.translations, self.ndof):
-            bcs.append(dolfinx.fem.dirichletbc(zero, free * self.ndof + comp, self._subspace(comp)))
+            bcs.append(_dolfinx.dirichletbc(zero, free * self.ndof + comp, self.V, comp))
         held = self.held_blocks()
-        if self.comm.allreduce(len(held)) or holding:  # nodes of no existing element (staged construction):
+        n_held = len(held) if self.comm.size == 1 else self.comm.allreduce(len(held))
+        if n_held or holding:  # nodes of no existing element (staged construction):
             # held where they are (the Function is made on every rank: its vector is collective)
             here = dolfinx.fem.Function(self.V)
             with self.displacement_vector().localForm() as x:
                 here.x.array[:] = x.array
-            if self.comm.allreduce(len(held)):
+            if n_held:
                 bcs.append(dolfinx.fem.dirichletbc(here, np.sort(held).astype(np.int32)))
             for dofs, comp in holding:  # supports added by a stage: where their nodes are
                 Vi, parent = self.V.sub(comp).collapse()
@@ -331,7 +326,7 @@ class Part:
                 inside[np.asarray(parent)] = np.arange(len(parent), dtype=np.int32)
                 g = dolfinx.fem.Function(Vi)
                 g.x.array[inside[dofs]] = here.x.array[dofs]
-                bcs.append(dolfinx.fem.dirichletbc(g, [dofs.astype(np.int32), inside[dofs]], self._subspace(comp)))
+                bcs.append(_dolfinx.dirichletbc(g, [dofs.astype(np.int32), inside[dofs]], self.V, comp))
         self._prescribed_values = []
         self.lifting_bcs = []
         for entities, comp, motion, cond in self._prescribed:
@@ -340,7 +335,7 @@ class Part:
             Vi, _ = self.V.sub(comp).collapse()
             g = dolfinx.fem.Function(Vi)
             dofs = dolfinx.fem.locate_dofs_topological((self.V.sub(comp), Vi), *entities)
-            bc = dolfinx.fem.dirichletbc(g, dofs, self._subspace(comp))
+            bc = _dolfinx.dirichletbc(g, dofs, self.V, comp)
             bcs.append(bc)
             self.lifting_bcs.append(bc)
             self._prescribed_values.append((g, dofs[1], motion))

@@ -598,6 +598,7 @@ class Rotations3D:
 
     state_size = NSTATE
     multiplicative_rotations = True
+    _owned_blocks = None  # owned nodes of the part's mesh (found at the first update)
     # The consistent tangent with respect to spatial spins is not symmetric: its skew part is
     # −½ spin(m_a) on each node's rotations, m_a the node's unbalanced moment sum (the bracket
     # of the rotation group; Simo & Vu-Quoc 1986, Nour-Omid & Rankin 1991, Crisfield 1997
@@ -631,9 +632,10 @@ class Rotations3D:
 
     def update(self, dx: PETSc.Vec) -> None:
         """u ← u + du; q ← exp(dw)∘q (multiplicative, spatial) on owned nodes; ghosts from their owners."""
-        n_owned = self.V.dofmap.index_map.size_local
+        if self._owned_blocks is None:  # (DOLFINx makes a new DofMap wrapper at every .dofmap)
+            self._owned_blocks = self.V.dofmap.index_map.size_local
         st = self.state.x.array.reshape(-1, NSTATE)
-        _update_quaternions(st, dx.array_r.reshape(-1, 6), n_owned)
+        _update_quaternions(st, dx.array_r.reshape(-1, 6), self._owned_blocks)
         self.state.x.scatter_forward()
 
     def extrapolate(self, older, newer, factor):

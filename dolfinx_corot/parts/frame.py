@@ -661,6 +661,14 @@ class Rotations3D:
     def _dof_values(s: np.ndarray) -> np.ndarray:
         return np.concatenate([s[:3], rotations.rotvec_from_quat(s[3:7].copy())])
 
+    def dof_values(self, blocks: np.ndarray) -> np.ndarray:
+        """(len(blocks), 6) displacements and rotation vectors of local blocks (all nodes at once)."""
+        st = self.state.x.array.reshape(-1, NSTATE)[np.asarray(blocks, dtype=np.int32)]
+        out = np.empty((len(st), 6))
+        out[:, :3] = st[:, :3]
+        out[:, 3:] = rotations.rotvecs_from_quats(np.ascontiguousarray(st[:, 3:7]))
+        return out
+
     def _rotation_values(self) -> np.ndarray:
         """Rotation vectors (blocks, 3) of the nodal quaternions (norm ≤ π)."""
         st = self.state.x.array.reshape(-1, NSTATE)

@@ -280,7 +280,8 @@ class Run:
             n = m.V.dofmap.index_map.size_local
             u = m.translations_of(np.arange(n))
             if u.size:
-                largest = max(largest, float(np.max(np.abs(u))) if np.all(np.isfinite(u)) else math.inf)
+                peak = float(np.abs(u).max())  # (NaN where any is: not finite)
+                largest = max(largest, peak) if math.isfinite(peak) else math.inf
         if self.system.comm.size > 1:
             largest = self.system.comm.allreduce(largest, op=MPI.MAX)
         size = self.model_size()

@@ -7,15 +7,28 @@ J = 0.140577, E = 5e7, ν = 0.2) with OpenSees's co-rotational transformation, t
 which is about our relative 1e-9 of the load (OpenSees then takes 101 iterations, we 100).
 Prints the in-solver time (``analyze``) of each of ``--repeats`` solves, the iterations and the tip.
 
-Needs OpenSeesPy (``pip install openseespy``, not a dependency of this project); run it with the
-Python that has it, e.g. in a venv of its own: ``python benchmarks/bend_opensees.py --repeats 15``.
+Writes output/bend_opensees/{bend_opensees.json, bend_opensees.csv (each run's time),
+bend_opensees.png (the times of the runs)}.
+
+Needs OpenSeesPy and Matplotlib (``pip install openseespy matplotlib``, not dependencies of this
+project); run it with the Python that has them, e.g. in a venv of its own:
+``python benchmarks/bend_opensees.py --repeats 15``.
 """
 import argparse
+import csv
+import json
 import math
 import statistics
 import time
+from pathlib import Path
 
-import openseespy.opensees as ops
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import openseespy.opensees as ops  # noqa: E402
+
+OUT = Path(__file__).resolve().parent.parent / "output" / "bend_opensees"
 
 R, E, NU, J, A, I = 100.0, 5e7, 0.2, 0.140577, 1.0, 1.0 / 12.0
 N = 8
@@ -58,6 +71,23 @@ def main() -> None:
     args = parser.parse_args()
     runs = [solve(args.tolerance) for _ in range(args.repeats)]
     times = [r[0] for r in runs]
+    OUT.mkdir(parents=True, exist_ok=True)
+    summary = {"peer": "OpenSeesPy", "version": ops.version() if hasattr(ops, "version") else None,
+               "tolerance": args.tolerance, "newton_iterations": runs[0][1], "tip": runs[0][2],
+               "solver_s_median": statistics.median(times), "solver_s_least": min(times), "solver_s": times}
+    (OUT / "bend_opensees.json").write_text(json.dumps(summary, indent=1))
+    with open(OUT / "bend_opensees.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["run", "solver_s", "newton_iterations"])
+        w.writerows([i + 1, t, it] for i, (t, it, _) in enumerate(runs))
+    fig, ax = plt.subplots(figsize=(5, 3))
+    ax.plot(range(1, len(times) + 1), [1e3 * t for t in times], "o-")
+    ax.set_xlabel("run")
+    ax.set_ylabel("time in analyze (ms)")
+    ax.set_title("OpenSees, 45° bend, 20 steps")
+    fig.tight_layout()
+    fig.savefig(OUT / "bend_opensees.png", dpi=100)
+    plt.close(fig)
     print(f"OpenSees 45° bend: in the solver median {1e3 * statistics.median(times):.1f} ms, "
           f"least {1e3 * min(times):.1f} ms over {len(times)} runs; {runs[0][1]} Newton iterations; tip {runs[0][2]}")
 

@@ -8,18 +8,25 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def scaled_dense(values, indptr, indices, K, s):
-    """K (n, n) = S A S from A's CSR arrays, S = diag(s), s_i = 1/√|a_ii| (1 where a_ii = 0):
-    the matrix scaled to a unit diagonal (entries (a_ij s_i) s_j)."""
-    n = K.shape[0]
-    for i in range(n):
+def unit_diagonal_scale(values, indptr, indices, s):
+    """s (n,): s_i = 1/√|a_ii| of A's CSR arrays (1 where a_ii = 0), S = diag(s) scaling A to a
+    unit diagonal."""
+    for i in range(len(s)):
         s[i] = 1.0
-        for j in range(n):
-            K[i, j] = 0.0
-    for i in range(n):
         for k in range(indptr[i], indptr[i + 1]):
             if indices[k] == i and values[k] != 0.0:
                 s[i] = 1.0 / np.sqrt(abs(values[k]))
+
+
+@numba.njit(cache=True)
+def scaled_dense(values, indptr, indices, K, s):
+    """K (n, n) = S A S from A's CSR arrays, S of :func:`unit_diagonal_scale` (filled in s):
+    the matrix scaled to a unit diagonal (entries (a_ij s_i) s_j)."""
+    n = K.shape[0]
+    for i in range(n):
+        for j in range(n):
+            K[i, j] = 0.0
+    unit_diagonal_scale(values, indptr, indices, s)
     for i in range(n):
         for k in range(indptr[i], indptr[i + 1]):
             j = indices[k]
@@ -65,13 +72,9 @@ def scaled_band(values, indptr, indices, kl, ku, ab, s):
     ab[kl + ku + i − j, j] = (a_ij s_i) s_j, the first kl rows left for the fill."""
     n = ab.shape[1]
     for j in range(n):
-        s[j] = 1.0
         for r in range(ab.shape[0]):
             ab[r, j] = 0.0
-    for i in range(n):
-        for k in range(indptr[i], indptr[i + 1]):
-            if indices[k] == i and values[k] != 0.0:
-                s[i] = 1.0 / np.sqrt(abs(values[k]))
+    unit_diagonal_scale(values, indptr, indices, s)
     for i in range(n):
         for k in range(indptr[i], indptr[i + 1]):
             j = indices[k]

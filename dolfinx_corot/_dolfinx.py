@@ -142,3 +142,40 @@ def function_space(mesh: dolfinx.mesh.Mesh, family: str, degree: int, dim: int |
     except TypeError:  # the Python Mesh wraps the C++ one
         cpp_space = dolfinx.cpp.fem.FunctionSpace(mesh._mesh, cpp_element, dofmap)
     return dolfinx.fem.FunctionSpace(mesh, element, cpp_space)
+
+
+def cell_integrals(form, bcs: list):
+    """What :class:`dolfinx_corot.assembly.cells.CellAssembler` needs to assemble an FFCx
+    bilinear form on one rank without DOLFINx: ``(integrals, blocks, geometry, x, constants,
+    coefficients, constrained, bs)``, or None for a form it does not cover (integrals other
+    than cell integrals, two different spaces, elements with dof transformations, conditions
+    on another space). integrals: ``(kernel address, cells, key of the packed coefficients)``;
+    constants(), coefficients(): the form's packed constants and coefficients (a dict by key)."""
+    import cffi
+
+    ufcx = getattr(form, "ufcx_form", None)
+    cell = dolfinx.cpp.fem.IntegralType.cell
+    if ufcx is None or form.rank != 2 or set(form.integral_types) != {cell}:
+        return None
+    V0, V1 = form.function_spaces
+    if V0 is not V1 and not (V0.contains(V1) and V1.contains(V0)):
+        return None
+    if V0.element.needs_dof_transformations:
+        return None
+    if not all(V0.contains(bc.function_space) for bc in bcs):
+        return None
+    ffi = cffi.FFI()
+    count = ufcx.num_integrals(0)
+    ids = ffi.unpack(ufcx.integral_ids(0), count)
+    integrals = []
+    for k, i in enumerate(ids):
+        kernel = ufcx.integrals(0)[k].tabulate_tensor_float64
+        cells = np.asarray(form.domains(cell, i), dtype=np.int32)
+        integrals.append((int(ffi.cast("uintptr_t", kernel)), cells, (cell, i)))
+    mesh = V0.mesh
+    geometry = mesh.geometry.dofmap.array.reshape(-1, mesh.geometry.dofmap.links(0).size)
+    bs = V0.dofmap.index_map_bs
+    blocks = V0.dofmap.list().array.reshape(-1, V0.dofmap.dof_layout.num_dofs)
+    constrained = np.concatenate([bc.dof_indices()[0] for bc in bcs]) if bcs else np.zeros(0, dtype=np.int32)
+    return (integrals, blocks, geometry, mesh.geometry.x, lambda: dolfinx.cpp.fem.pack_constants(form),
+            lambda: dolfinx.cpp.fem.pack_coefficients(form), constrained, bs)

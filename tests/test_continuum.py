@@ -2,6 +2,7 @@
 import gmsh
 import numpy as np
 import pytest
+from petsc4py import PETSc
 from mpi4py import MPI
 
 import dolfinx_corot as dc
@@ -305,4 +306,97 @@ def test_the_predictors_are_the_polynomials_through_the_converged_states():
         res = dc.solve(sc, dc.LoadControl(steps=4, extrapolate=how))
         tips[how] = res.history.column("tip_uy")[-1]
     assert tips["quadratic"] == pytest.approx(tips["secant"], rel=1e-7)
+    system.destroy()
+
+
+def _move_to(system, model, u):
+    """The system's configuration to displacement u (local dofs, owned first), as a Newton
+    update would make it."""
+    m = system.dx.getLocalSize()
+    system.dx.array[:] = (u - model.state.x.array)[:m]
+    system.update()
+
+
+def _deformed_block(cell, degree, material, n=(6, 2, 2)):
+    tm = dc.io.mesh.box((3.0, 1.0, 1.0), n, cell=cell)
+    sc = dc.Scene(linear_solver="direct")
+    b = sc.add_solid(tm, material=material, degree=degree)
+    sc.fix(b, "x0")
+    sc.fix(b, "x1", dofs=("uz",))
+    sc.load(b, "x1", traction=(0.0, -75.0, 0.0))
+    return sc
+
+
+@pytest.mark.parametrize("cell, degree, material", [
+    ("hexahedron", 1, dc.SaintVenantKirchhoff(1e5, 0.3)), ("hexahedron", 2, dc.NeoHookean(1e5, 0.3)),
+    ("tetrahedron", 1, dc.NeoHookean(1e5, 0.3)), ("tetrahedron", 2, dc.SaintVenantKirchhoff(1e5, 0.3))],
+    ids=["hex-Q1", "hex-Q2", "tet-P1", "tet-P2"])
+def test_compiled_assembly_is_dolfinx_assembly_bit_for_bit(monkeypatch, cell, degree, material):
+    """On one rank a continuum's tangent is added into the AIJ matrix's values by a compiled
+    loop (assembly.cells): at a deformed state, with supports of all and of one component,
+    it is DOLFINx's assembly to the last bit (the same sums in the same order), and the direct
+    solver sees the new values (MUMPS refactorizes: the matrix's state has changed)."""
+    from dolfinx_corot.assembly import cells
+
+    monkeypatch.setattr(cells, "MIN_CELLS", 0)
+    sc = _deformed_block(cell, degree, material)
+    system = make_system(sc.model, solver="direct")
+    model = sc.model
+    system.jacobian()  # DOLFINx's: lays out the pattern
+    if comm.size > 1:
+        assert system._cells is None  # several ranks: DOLFINx's assembly throughout
+        system.destroy()
+        return
+    assert system._cells is not None
+    rng = np.random.default_rng(1)
+    for trial in range(2):
+        _move_to(system, model, 0.01 * rng.normal(size=model.state.x.array.size))
+        system.residual(0.5)
+        system.jacobian()
+        fast = system.A.getValuesCSR()[2].copy()
+        x = system.A.createVecRight()
+        system.solve(system.b, x)
+        Ax = system.A.createVecLeft()
+        system.A.mult(x, Ax)
+        Ax.axpy(-1.0, system.b)
+        assert Ax.norm() < 1e-9 * system.b.norm()  # solved with this tangent, not the last one
+        saved, system._cells = system._cells, None
+        system._assemble_parts_matrix()
+        assert np.array_equal(system.A.getValuesCSR()[2], fast)
+        system._cells = saved
+    system.destroy()
+
+
+def test_the_amg_near_nullspace_is_the_current_configuration_s_rigid_motions():
+    """A free block turned rigidly by 1.2 rad: its tangent (no stress: material stiffness only)
+    annihilates the translations and the infinitesimal rotations of x = X + u, which the
+    AMG gets as its near-nullspace; rotations about the reference X are far from free."""
+    from dolfinx_corot.assembly import petsc
+
+    tm = dc.io.mesh.box((2.0, 1.0, 1.0), (4, 2, 2))
+    sc = dc.Scene(linear_solver="iterative")
+    sc.add_solid(tm, material=dc.SaintVenantKirchhoff(1e5, 0.3), degree=1)
+    system = make_system(sc.model, solver="iterative")
+    model = sc.model
+    n = model.V.dofmap.index_map.size_local
+    X = model.V.tabulate_dof_coordinates()[:, :3]
+    c, s = np.cos(1.2), np.sin(1.2)
+    R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    _move_to(system, model, (X @ R.T - X).ravel())
+    system.jacobian()
+    scale = system.A.norm(PETSc.NormType.FROBENIUS)
+    reference = model.near_nullspace_modes()
+    model.state.x.array[:] = 0.0
+    at_rest = model.near_nullspace_modes()  # X alone
+    model.state.x.array[:] = (X @ R.T - X).ravel()
+    v, y = system.A.createVecRight(), system.A.createVecLeft()
+
+    def residual(mode):
+        v.array[:] = mode[:n].ravel()
+        system.A.mult(v, y)
+        return y.norm() / (scale * v.norm())
+
+    assert max(residual(m) for m in model.near_nullspace_modes()) < 1e-12
+    assert min(residual(m) for m in at_rest[3:]) > 1e-3  # rotations of X: not free at this state
+    assert all(np.array_equal(a, b) for a, b in zip(reference, model.near_nullspace_modes()))
     system.destroy()

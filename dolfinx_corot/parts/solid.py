@@ -85,6 +85,7 @@ class Solid(AdditiveState, Part):
         self.V = _dolfinx.function_space(mesh, "Lagrange", degree, mesh.geometry.dim)
         self.nodes_per_cell = self.V.dofmap.dof_layout.num_dofs  # dof blocks per cell
         self.state = dolfinx.fem.Function(self.V, name="displacement")
+        self._dof_coordinates = None  # owned dofs' reference coordinates (near-nullspace modes)
         self.reference_shift = dolfinx.fem.Function(self.V, name="reference_shift")
         self._shifted = None
         Q = _dolfinx.function_space(mesh, "DG", 0, scalar=True)
@@ -685,10 +686,15 @@ class Solid(AdditiveState, Part):
     # -- linear solver -------------------------------------------------------------
     def near_nullspace_modes(self) -> list[np.ndarray]:
         """Rigid-body modes (3 in 2D, 6 in 3D) on the owned blocks of V ((n_owned, gdim) each), the
-        near-nullspace of algebraic multigrid."""
+        near-nullspace of algebraic multigrid: translations, and infinitesimal rotations of the
+        current configuration x = X + u (X: the reference, shifted where a stage mapped it),
+        which are nearly free motions of the tangent at u."""
         n_owned = self.V.dofmap.index_map.size_local
-        x = self.V.tabulate_dof_coordinates()[:n_owned]
         d = self.gdim
+        if self._dof_coordinates is None:
+            self._dof_coordinates = self.V.tabulate_dof_coordinates()[:n_owned, :d].copy()
+        x = self._dof_coordinates + self.reference_shift.x.array.reshape(-1, d)[:n_owned] \
+            + self.state.x.array.reshape(-1, d)[:n_owned]
         modes = []
         for k in range(d):
             m = np.zeros((n_owned, d))

@@ -1,0 +1,120 @@
+"""The peer of the SVK block benchmark (``benchmarks/block3d.py``) in CalculiX, to measure both
+side by side in one sitting (issue 18: the 116 k-dof block at least 8 times faster than the peers).
+
+The same model: a cantilever block L = 10, 1 × 1 section, E = 1e5, ν = 0.3, clamped at x = 0,
+n_x × n_y × n_z trilinear hexahedra with full 2 × 2 × 2 integration (CalculiX's C3D8; a linear
+elastic material under NLGEOM is St Venant–Kirchhoff there as here), a dead transverse load of
+resultant 75 on the end face (as nodal forces of the uniform traction: CalculiX's distributed
+loads follow the face under NLGEOM) in 5 fixed increments. The linear solver is CalculiX's
+iterative one (``SOLVER=ITERATIVE CHOLESKY``: CG preconditioned by an incomplete Cholesky) or
+SPOOLES (``--solver spooles``). CalculiX's own convergence criterion (residual 0.5 % of the
+average force) is looser than ours; its Newton iterations are reported beside the time.
+
+Writes output/block_calculix/block_<mesh>_<solver>.{inp, json} and prints the JSON: the wall
+time of ``ccx`` (one thread), its peak resident memory, the Newton iterations and the tip's
+displacement at the end face's centre (needs even n_y and n_z).
+
+Needs ``ccx`` (Debian: ``apt-get install calculix-ccx``), not a dependency of this project:
+``python benchmarks/block_calculix.py --mesh 150 15 15``.
+"""
+import argparse
+import json
+import os
+import re
+import resource
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+
+OUT = Path(__file__).resolve().parent.parent / "output" / "block_calculix"
+L, E, NU, LOAD = 10.0, 1e5, 0.3, 75.0
+
+
+def write_input(path: Path, n: tuple[int, int, int], solver: str) -> int:
+    """The input deck; returns the tip node's number (0 if the end face has no centre node)."""
+    nx, ny, nz = n
+    x = np.linspace(0.0, L, nx + 1)
+    y = np.linspace(0.0, 1.0, ny + 1)
+    z = np.linspace(0.0, 1.0, nz + 1)
+
+    def node(i, j, k):
+        return 1 + i + (nx + 1) * (j + (ny + 1) * k)
+
+    lines = ["*HEADING", "SVK cantilever block (dolfinx_corot benchmarks/block_calculix.py)", "*NODE"]
+    K, J, I = np.meshgrid(np.arange(nz + 1), np.arange(ny + 1), np.arange(nx + 1), indexing="ij")
+    ids = node(I, J, K).ravel()
+    coords = np.column_stack([x[I.ravel()], y[J.ravel()], z[K.ravel()]])
+    lines += [f"{i},{a:.12g},{b:.12g},{c:.12g}" for i, (a, b, c) in zip(ids, coords)]
+    lines.append("*ELEMENT, TYPE=C3D8, ELSET=EALL")
+    e = 1
+    for k in range(nz):
+        for j in range(ny):
+            for i in range(nx):
+                c = [node(i, j, k), node(i + 1, j, k), node(i + 1, j + 1, k), node(i, j + 1, k),
+                     node(i, j, k + 1), node(i + 1, j, k + 1), node(i + 1, j + 1, k + 1), node(i, j + 1, k + 1)]
+                lines.append(f"{e}," + ",".join(map(str, c)))
+                e += 1
+    lines.append("*NSET, NSET=FIXED")
+    fixed = [node(0, j, k) for k in range(nz + 1) for j in range(ny + 1)]
+    lines += [",".join(map(str, fixed[i:i + 16])) for i in range(0, len(fixed), 16)]
+    tip = node(nx, ny // 2, nz // 2) if ny % 2 == 0 and nz % 2 == 0 else 0
+    lines += ["*NSET, NSET=TIP", str(tip)] if tip else []
+    lines += ["*BOUNDARY", "FIXED,1,3", "*MATERIAL, NAME=SVK", "*ELASTIC", f"{E:g},{NU:g}",
+              "*SOLID SECTION, ELSET=EALL, MATERIAL=SVK",
+              "*STEP, NLGEOM, INC=1000",
+              f"*STATIC, DIRECT, SOLVER={'ITERATIVE CHOLESKY' if solver == 'iterative' else 'SPOOLES'}",
+              "0.2, 1.0", "*CLOAD"]
+    # nodal forces of a uniform traction on a bilinear face grid: the tributary areas
+    wy = np.full(ny + 1, 1.0 / ny)
+    wy[[0, -1]] *= 0.5
+    wz = np.full(nz + 1, 1.0 / nz)
+    wz[[0, -1]] *= 0.5
+    for k in range(nz + 1):
+        for j in range(ny + 1):
+            lines.append(f"{node(nx, j, k)},2,{-LOAD * wy[j] * wz[k]:.15g}")
+    if tip:
+        lines += ["*NODE PRINT, NSET=TIP", "U"]
+    lines += ["*END STEP", ""]
+    path.write_text("\n".join(lines))
+    return tip
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--mesh", type=int, nargs=3, default=[150, 15, 15])
+    ap.add_argument("--solver", choices=["iterative", "spooles"], default="iterative")
+    args = ap.parse_args()
+    ccx = shutil.which("ccx")
+    if ccx is None:
+        raise SystemExit("ccx not found: apt-get install calculix-ccx")
+    OUT.mkdir(parents=True, exist_ok=True)
+    stem = OUT / f"block_{'x'.join(map(str, args.mesh))}_{args.solver}"
+    tip = write_input(stem.with_suffix(".inp"), tuple(args.mesh), args.solver)
+    env = dict(os.environ, OMP_NUM_THREADS="1", CCX_NPROC_EQUATION_SOLVER="1", CCX_NPROC_STIFFNESS="1",
+               CCX_NPROC_RESULTS="1")
+    t = time.perf_counter()
+    run = subprocess.run([ccx, "-i", stem.name], cwd=OUT, env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - t
+    if run.returncode != 0 or "Job finished" not in run.stdout:
+        raise SystemExit(f"ccx failed:\n{run.stdout[-2000:]}\n{run.stderr[-2000:]}")
+    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0
+    iterations = len(re.findall(r"^\s*iteration\s+\d+", run.stdout, flags=re.M))
+    increments = len(re.findall(r"^\s*increment\s+\d+", run.stdout, flags=re.M))
+    u = None
+    if tip:
+        dat = stem.with_suffix(".dat").read_text().split()
+        # the last block "displacements (vx,vy,vz) for set TIP ... time 1.0": node ux uy uz
+        k = len(dat) - 1 - dat[::-1].index(str(tip))
+        u = [float(v) for v in dat[k + 1:k + 4]]
+    data = {"peer": "CalculiX", "ccx": ccx, "mesh": args.mesh, "solver": args.solver,
+            "dofs": 3 * int(np.prod(np.array(args.mesh) + 1)), "wall_s": wall, "peak_rss_MB": peak,
+            "increments": increments, "newton_iterations": iterations, "tip_displacement": u}
+    stem.with_suffix(".json").write_text(json.dumps(data, indent=1))
+    print(json.dumps(data, indent=1))
+
+
+if __name__ == "__main__":
+    main()

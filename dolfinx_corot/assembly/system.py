@@ -410,9 +410,10 @@ class System:
 
     def _cell_assembler(self):
         """The compiled assembly of the parts' tangent (:mod:`.cells`), or None where DOLFINx's
-        stays: several ranks, forms other than one FFCx form of cell integrals, small meshes."""
-        if self.A.getType() != "seqaij" or np.dtype(PETSc.IntType) != np.int32:
-            return None
+        stays: several ranks, contributions (contact), forms other than FFCx forms of cell
+        integrals, small meshes."""
+        if self.contributions or self.A.getType() != "seqaij" or np.dtype(PETSc.IntType) != np.int32:
+            return None  # (contributions merge their couplings into A's pattern)
         parts = _dolfinx.cell_integrals(self.a, self.bcs)
         if parts is None:
             return None

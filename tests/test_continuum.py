@@ -333,8 +333,8 @@ def _deformed_block(cell, degree, material, n=(6, 2, 2)):
     ids=["hex-Q1", "hex-Q2", "tet-P1", "tet-P2"])
 def test_compiled_assembly_is_dolfinx_assembly_bit_for_bit(monkeypatch, cell, degree, material):
     """On one rank a continuum's tangent is added into the AIJ matrix's values by a compiled
-    loop (assembly.cells): at a deformed state, with supports of all and of one component,
-    it is DOLFINx's assembly to the last bit (the same sums in the same order), and the direct
+    loop (assembly.cells): at a deformed state, with supports of all and of one component, and
+    with extra couplings in single rows, it is DOLFINx's assembly to the last bit (the same sums in the same order), and the direct
     solver sees the new values (MUMPS refactorizes: the matrix's state has changed)."""
     from dolfinx_corot.assembly import cells
 
@@ -350,6 +350,12 @@ def test_compiled_assembly_is_dolfinx_assembly_bit_for_bit(monkeypatch, cell, de
     assert system._cells is not None
     rng = np.random.default_rng(1)
     for trial in range(2):
+        if trial == 1:  # a coupling in one row of a node only (its rows' columns no longer alike)
+            system.A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+            n = system.A.getSize()[0]
+            system.A.setValue(4, n - 1, 0.0, addv=PETSc.InsertMode.ADD_VALUES)
+            system.A.setValue(n - 2, 1, 0.0, addv=PETSc.InsertMode.ADD_VALUES)
+            system.A.assemble()
         _move_to(system, model, 0.01 * rng.normal(size=model.state.x.array.size))
         system.residual(0.5)
         system.jacobian()

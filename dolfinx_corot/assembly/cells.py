@@ -5,10 +5,11 @@ row for every column: for trilinear hexahedra with three dofs a node (24 × 24 e
 matrices) that costs as much as the FFCx kernel itself. Here a small C loop (compiled by cffi
 on first use, as FFCx compiles forms, and cached on disk) calls the form's FFCx kernel cell by
 cell and adds each 3 × 3 nodal block where it lies in the row: the column's place is found
-once per pair of nodes, by bisection in the row's sorted columns, and serves the block's three
-rows. Rows and columns of constrained dofs are left out and their diagonal set to 1, as
-DOLFINx's ``assemble_matrix`` with Dirichlet conditions and ``insert_diagonal`` do; the
-entries are added in DOLFINx's order, so the matrix is the same to the last bit.
+once per pair of nodes, by bisection in the row's sorted columns, and serves the block's other
+rows wherever their columns are laid out alike (checked; otherwise they are searched too).
+Rows and columns of constrained dofs are left out and their diagonal set to 1, as DOLFINx's
+``assemble_matrix`` with Dirichlet conditions and ``insert_diagonal`` do; the entries are
+added in DOLFINx's order, so the matrix is the same to the last bit.
 
 Used by :class:`~dolfinx_corot.assembly.system.System` on one rank for FFCx forms whose
 integrals are all cell integrals over meshes of at least :data:`MIN_CELLS` cells.
@@ -72,22 +73,39 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
       const int64_t start = indptr[row0], stop = indptr[row0 + 1];
       for (int64_t j = 0; j < nb; ++j)
       {
-        const int64_t p = find(indices, start, stop, (int64_t)nodes[j] * bs);
-        place[j] = p < 0 ? -1 : p - start;
-        missing += p < 0;
+        const int64_t col0 = (int64_t)nodes[j] * bs;
+        const int64_t p = find(indices, start, stop, col0);
+        const int whole = p >= 0 && p + bs <= stop && indices[p + bs - 1] == col0 + bs - 1;
+        place[j] = whole ? p - start : -1;
+        missing += !whole;
       }
       for (int64_t a = 0; a < bs; ++a)
       {
         const int64_t row = row0 + a;
         if (constrained[row])
           continue;
-        double* v = values + indptr[row];
+        const int64_t first = indptr[row], last = indptr[row + 1];
+        double* v = values + first;
         const double* e = Ae + (i * bs + a) * n;
         for (int64_t j = 0; j < nb; ++j)
         {
           if (place[j] < 0)
             continue;
-          double* vj = v + place[j];
+          int64_t at = place[j];
+          const int64_t col0 = (int64_t)nodes[j] * bs;
+          if (a > 0 && (first + at + bs > last || indices[first + at] != col0
+                        || indices[first + at + bs - 1] != col0 + bs - 1))
+          {
+            /* this row's columns are not laid out as the node's first row's */
+            const int64_t p = find(indices, first, last, col0);
+            if (p < 0 || p + bs > last || indices[p + bs - 1] != col0 + bs - 1)
+            {
+              ++missing;
+              continue;
+            }
+            at = p - first;
+          }
+          double* vj = v + at;
           const double* ej = e + j * bs;
           if (!held)
             for (int64_t b = 0; b < bs; ++b)

@@ -410,10 +410,11 @@ class System:
 
     def _cell_assembler(self):
         """The compiled assembly of the parts' tangent (:mod:`.cells`), or None where DOLFINx's
-        stays: several ranks, contributions (contact), forms other than FFCx forms of cell
-        integrals, small meshes."""
-        if self.contributions or self.A.getType() != "seqaij" or np.dtype(PETSc.IntType) != np.int32:
-            return None  # (contributions merge their couplings into A's pattern)
+        stays: several ranks, forms other than FFCx forms of cell integrals, small meshes.
+        Contributions (contact) merge their couplings into A's pattern, so that a node's rows
+        may differ in their columns: the loop checks each row's layout."""
+        if self.A.getType() != "seqaij" or np.dtype(PETSc.IntType) != np.int32:
+            return None
         parts = _dolfinx.cell_integrals(self.a, self.bcs)
         if parts is None:
             return None

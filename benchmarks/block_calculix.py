@@ -10,14 +10,18 @@ iterative one (``SOLVER=ITERATIVE CHOLESKY``: CG preconditioned by an incomplete
 SPOOLES (``--solver spooles``). CalculiX's own convergence criterion (residual 0.5 % of the
 average force) is looser than ours; its Newton iterations are reported beside the time.
 
-Writes output/block_calculix/block_<mesh>_<solver>.{inp, json} and prints the JSON: the wall
-time of ``ccx`` (one thread), its peak resident memory, the Newton iterations and the tip's
-displacement at the end face's centre (needs even n_y and n_z).
+Writes output/block_calculix/block_<mesh>_<solver>.{inp, json, csv, png} and prints the JSON:
+the wall time of ``ccx`` (one thread), its peak resident memory, the Newton iterations and the
+tip's displacement at the end face's centre (needs even n_y and n_z); the CSV is CalculiX's
+convergence history (increment, iteration, residual and correction in % of its criteria' scales),
+the PNG plots it.
 
-Needs ``ccx`` (Debian: ``apt-get install calculix-ccx``), not a dependency of this project:
+Needs ``ccx`` (Debian: ``apt-get install calculix-ccx``), not a dependency of this project, and
+Matplotlib:
 ``python benchmarks/block_calculix.py --mesh 150 15 15``.
 """
 import argparse
+import csv
 import json
 import os
 import re
@@ -113,7 +117,42 @@ def main() -> None:
             "dofs": 3 * int(np.prod(np.array(args.mesh) + 1)), "wall_s": wall, "peak_rss_MB": peak,
             "increments": increments, "newton_iterations": iterations, "tip_displacement": u}
     stem.with_suffix(".json").write_text(json.dumps(data, indent=1))
+    history = _convergence(stem.with_suffix(".cvg"))
+    with open(stem.with_suffix(".csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["increment", "iteration", "residual_percent", "correction_percent"])
+        w.writerows(history)
+    _plot(history, data, stem.with_suffix(".png"))
     print(json.dumps(data, indent=1))
+
+
+def _convergence(path: Path) -> list:
+    """(increment, iteration, residual %, correction %) rows of CalculiX's .cvg file."""
+    rows = []
+    for line in path.read_text().splitlines():
+        parts = line.split()
+        if len(parts) >= 7 and parts[0].isdigit():
+            rows.append((int(parts[1]), int(parts[3]), float(parts[5]), float(parts[6])))
+    return rows
+
+
+def _plot(history: list, data: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    for inc in sorted({r[0] for r in history}):
+        its = [r for r in history if r[0] == inc]
+        ax.semilogy([r[1] for r in its], [r[2] for r in its], "o-", label=f"increment {inc}")
+    ax.set_xlabel("iteration")
+    ax.set_ylabel("residual (% of CalculiX's scale)")
+    ax.set_title(f"CalculiX, {data['dofs']} dofs: {data['wall_s']:.1f} s, {data['peak_rss_MB']:.0f} MB")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 if __name__ == "__main__":

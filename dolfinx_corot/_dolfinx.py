@@ -173,7 +173,7 @@ def cell_integrals(form, bcs: list):
         cells = np.asarray(form.domains(cell, i), dtype=np.int32)
         integrals.append((int(ffi.cast("uintptr_t", kernel)), cells, (cell, i)))
     mesh = V0.mesh
-    geometry = mesh.geometry.dofmap.array.reshape(-1, mesh.geometry.dofmap.links(0).size)
+    geometry = mesh.geometry.dofmap.array.reshape(-1, mesh.geometry.cmap.create_dof_layout().num_dofs)
     bs = V0.dofmap.index_map_bs
     blocks = V0.dofmap.list().array.reshape(-1, V0.dofmap.dof_layout.num_dofs)
     constrained = np.concatenate([bc.dof_indices()[0] for bc in bcs]) if bcs else np.zeros(0, dtype=np.int32)

@@ -332,10 +332,12 @@ def _deformed_block(cell, degree, material, n=(6, 2, 2)):
     ("tetrahedron", 1, dc.NeoHookean(1e5, 0.3)), ("tetrahedron", 2, dc.SaintVenantKirchhoff(1e5, 0.3))],
     ids=["hex-Q1", "hex-Q2", "tet-P1", "tet-P2"])
 def test_compiled_assembly_is_dolfinx_assembly_bit_for_bit(monkeypatch, cell, degree, material):
-    """On one rank a continuum's tangent is added into the AIJ matrix's values by a compiled
-    loop (assembly.cells): at a deformed state, with supports of all and of one component, and
-    with extra couplings in single rows, it is DOLFINx's assembly to the last bit (the same sums in the same order), and the direct
-    solver sees the new values (MUMPS refactorizes: the matrix's state has changed)."""
+    """A continuum's tangent is added into the AIJ matrix's values by a compiled loop
+    (assembly.cells; on several ranks into the owned rows' diagonal and off-diagonal blocks, the
+    rows of ghost nodes sent to their owners): at a deformed state, with supports of all and of
+    one component, and with extra couplings in single rows, it is DOLFINx's assembly to the last
+    bit (the same sums in the same order), and the direct solver sees the new values (MUMPS
+    refactorizes: the matrix's state has changed)."""
     from dolfinx_corot.assembly import cells
 
     monkeypatch.setattr(cells, "MIN_CELLS", 0)
@@ -343,11 +345,9 @@ def test_compiled_assembly_is_dolfinx_assembly_bit_for_bit(monkeypatch, cell, de
     system = make_system(sc.model, solver="direct")
     model = sc.model
     system.jacobian()  # DOLFINx's: lays out the pattern
-    if comm.size > 1:
-        assert system._cells is None  # several ranks: DOLFINx's assembly throughout
-        system.destroy()
-        return
     assert system._cells is not None
+    if comm.size > 1:  # the ranks share nodes: some element matrices have rows of ghost nodes
+        assert comm.allreduce(len(system._cells.ghost_cells), op=MPI.MIN) > 0
     rng = np.random.default_rng(1)
     for trial in range(2):
         if trial == 1:  # a coupling in one row of a node only (its rows' columns no longer alike)
@@ -371,6 +371,68 @@ def test_compiled_assembly_is_dolfinx_assembly_bit_for_bit(monkeypatch, cell, de
         assert np.array_equal(system.A.getValuesCSR()[2], fast)
         system._cells = saved
     system.destroy()
+
+
+@pytest.mark.parametrize("n, degree", [((6, 2, 2), 1), ((3, 1, 1), 2)], ids=["hex-Q1", "hex-Q2"])
+def test_cg_reads_the_tangent_s_upper_triangle_in_nodal_blocks(n, degree):
+    """The iterative solver's operator is the upper triangle of the AIJ tangent in 3 × 3 blocks
+    (SBAIJ; AMG is built from the AIJ matrix): at a deformed state with supports it holds the
+    values PETSc's own conversion gives, to the last bit, and so acts as the AIJ tangent does;
+    it is copied again only when the tangent has changed; and the Newton path with it ends
+    where the path with the AIJ operator ends, in as many Krylov iterations."""
+    from dolfinx_corot.assembly import petsc
+
+    sc = _deformed_block("hexahedron", degree, dc.SaintVenantKirchhoff(1e5, 0.3), n=n)
+    system = make_system(sc.model, solver="iterative")
+    rng = np.random.default_rng(3)
+    _move_to(system, sc.model, 0.01 * rng.normal(size=sc.model.state.x.array.size))
+    system.residual(0.5)
+    system.jacobian()
+    A = system.A
+    A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    reference = A.convert("sbaij", PETSc.Mat())  # PETSc's MatConvert (slow, element by element)
+    op = petsc.SymmetricBlockOperator(A)
+    op.refresh()
+    dense = [M.convert("dense", PETSc.Mat()) for M in (op.S, reference)]
+    assert np.array_equal(dense[0].getDenseArray(), dense[1].getDenseArray())
+    x, y, z = A.createVecRight(), A.createVecLeft(), A.createVecLeft()
+    x.setRandom()
+    A.mult(x, y)
+    op.S.mult(x, z)
+    z.axpy(-1.0, y)
+    assert z.norm() <= 1e-14 * y.norm()
+    state = op.S.stateGet()
+    op.refresh()
+    assert op.S.stateGet() == state  # A unchanged: nothing copied
+    _move_to(system, sc.model, 0.02 * rng.normal(size=sc.model.state.x.array.size))
+    system.residual(0.5)
+    system.jacobian()
+    op.refresh()
+    A.mult(x, y)
+    op.S.mult(x, z)
+    z.axpy(-1.0, y)
+    assert z.norm() <= 1e-14 * y.norm()
+    petsc.destroy(op, reference, *dense, x, y, z)
+    system.destroy()
+    tips, krylov = {}, {}
+    for name, value in (("blocks", "true"), ("aij", "false")):
+        options = PETSc.Options()
+        options["dc_newton_block_operator"] = value
+        try:
+            sc = _cantilever_block()
+            system = make_system(sc.model, solver="iterative")
+        finally:
+            del options["dc_newton_block_operator"]
+        assert (system.linear.ksp.getOperators()[0].getType().endswith("sbaij")) == (name == "blocks") or \
+            system.linear.operator is None
+        res = dc.solve(sc, dc.LoadControl(steps=2, extrapolate=True), system=system)
+        assert (system.linear.operator is not None) == (name == "blocks")
+        assert system.linear.ksp.getOperators()[0].getType().endswith("sbaij") == (name == "blocks")
+        tips[name] = res.history.column("tip_uy")[-1]
+        krylov[name] = system.krylov_iterations
+        system.destroy()
+    assert tips["blocks"] == pytest.approx(tips["aij"], rel=1e-8)
+    assert abs(krylov["blocks"] - krylov["aij"]) <= 2
 
 
 def test_the_amg_near_nullspace_is_the_current_configuration_s_rigid_motions():

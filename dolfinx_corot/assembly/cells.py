@@ -1,4 +1,4 @@
-"""A continuum's tangent on one rank, assembled straight into the values of PETSc's AIJ matrix.
+"""A continuum's tangent assembled straight into the values of PETSc's AIJ matrix.
 
 DOLFINx 0.5.2 inserts each element matrix through ``MatSetValuesLocal``, which searches its
 row for every column: for trilinear hexahedra with three dofs a node (24 × 24 element
@@ -11,8 +11,18 @@ Rows and columns of constrained dofs are left out and their diagonal set to 1, a
 ``assemble_matrix`` with Dirichlet conditions and ``insert_diagonal`` do; the entries are
 added in DOLFINx's order, so the matrix is the same to the last bit.
 
-Used by :class:`~dolfinx_corot.assembly.system.System` on one rank for FFCx forms whose
-integrals are all cell integrals over meshes of at least :data:`MIN_CELLS` cells.
+On several ranks the loop writes the owned nodes' rows into the two blocks of PETSc's MPIAIJ
+matrix (the owned columns, and the other columns through the block's sorted global column
+map) and hands the element matrices of cells with ghost nodes back whole: their ghost rows go
+to the owners through ``MatSetValuesBlockedLocal`` and the matrix's assembly, as DOLFINx sends
+them, so that the matrix is again DOLFINx's to the last bit.
+
+The same library copies a symmetric AIJ matrix's upper triangle into an SBAIJ matrix of its
+nodal blocks (:func:`upper_blocks`; the operator of the iterative solver,
+:class:`~dolfinx_corot.assembly.petsc.SymmetricBlockOperator`).
+
+Used by :class:`~dolfinx_corot.assembly.system.System` for FFCx forms whose integrals are all
+cell integrals over meshes of at least :data:`MIN_CELLS` cells (on every rank).
 """
 from __future__ import annotations
 
@@ -25,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-MIN_CELLS = 4000  # meshes with fewer cells keep DOLFINx's insertion
+MIN_CELLS = 4000  # meshes with fewer cells (on some rank) keep DOLFINx's insertion
 
 _SOURCE = r"""
 #include <stdint.h>
@@ -47,10 +57,19 @@ static int64_t find(const int32_t* indices, int64_t lo, int64_t hi, int64_t colu
   return (lo < stop && indices[lo] == column) ? lo : -1;
 }
 
+/* The element matrices of ``cells`` added into the rows of owned nodes (node < owned): columns of
+   owned nodes into the CSR block (indptr, indices, values) at column node * bs, columns of ghost
+   nodes into the CSR block (indptr_o, indices_o, values_o) at column ghost_column[node - owned]
+   (several ranks: PETSc's off-diagonal block). The element matrix of the k-th cell goes whole
+   to ghost + ghost_slot[k] * n * n as well where ghost_slot[k] >= 0 (its rows of ghost nodes are
+   sent to their owners by the caller). Rows and columns of constrained dofs are left out (zero in
+   the copy). Returns the number of entries the pattern lacks. */
 int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64_t nb, const int32_t* blocks,
                   int64_t ng, const int32_t* geometry, const double* x, const double* w, int64_t wstride,
-                  const double* c, const int32_t* indptr, const int32_t* indices, const uint8_t* constrained,
-                  int64_t bs, double* values, double* Ae, double* X, int64_t* place)
+                  const double* c, int64_t owned, const int32_t* indptr, const int32_t* indices, double* values,
+                  const int32_t* ghost_column, const int32_t* indptr_o, const int32_t* indices_o,
+                  double* values_o, const uint8_t* constrained, int64_t bs, double* ghost,
+                  const int64_t* ghost_slot, double* Ae, double* X, int64_t* place)
 {
   tabulate_t kernel = (tabulate_t)address;
   const int64_t n = nb * bs;
@@ -67,15 +86,30 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
     int held = 0;
     for (int64_t i = 0; i < n; ++i)
       held |= constrained[nodes[i / bs] * bs + i % bs];
+    if (ghost_slot != NULL && ghost_slot[k] >= 0)
+    {
+      double* g = ghost + ghost_slot[k] * n * n;
+      for (int64_t i = 0; i < n; ++i)
+      {
+        const int row_held = constrained[nodes[i / bs] * bs + i % bs];
+        for (int64_t j = 0; j < n; ++j)
+          g[i * n + j] = (row_held || constrained[nodes[j / bs] * bs + j % bs]) ? 0.0 : Ae[i * n + j];
+      }
+    }
     for (int64_t i = 0; i < nb; ++i)
     {
+      if (nodes[i] >= owned)
+        continue; /* a ghost node's rows: its owner's */
       const int64_t row0 = (int64_t)nodes[i] * bs;
-      const int64_t start = indptr[row0], stop = indptr[row0 + 1];
       for (int64_t j = 0; j < nb; ++j)
       {
-        const int64_t col0 = (int64_t)nodes[j] * bs;
-        const int64_t p = find(indices, start, stop, col0);
-        const int whole = p >= 0 && p + bs <= stop && indices[p + bs - 1] == col0 + bs - 1;
+        const int off = nodes[j] >= owned;
+        const int32_t* ip = off ? indptr_o : indptr;
+        const int32_t* ix = off ? indices_o : indices;
+        const int64_t col0 = off ? (int64_t)ghost_column[nodes[j] - owned] : (int64_t)nodes[j] * bs;
+        const int64_t start = ip[row0], stop = ip[row0 + 1];
+        const int64_t p = col0 < 0 ? -1 : find(ix, start, stop, col0);
+        const int whole = p >= 0 && p + bs <= stop && ix[p + bs - 1] == col0 + bs - 1;
         place[j] = whole ? p - start : -1;
         missing += !whole;
       }
@@ -84,28 +118,29 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
         const int64_t row = row0 + a;
         if (constrained[row])
           continue;
-        const int64_t first = indptr[row], last = indptr[row + 1];
-        double* v = values + first;
         const double* e = Ae + (i * bs + a) * n;
         for (int64_t j = 0; j < nb; ++j)
         {
           if (place[j] < 0)
             continue;
+          const int off = nodes[j] >= owned;
+          const int32_t* ix = off ? indices_o : indices;
+          const int64_t first = (off ? indptr_o : indptr)[row], last = (off ? indptr_o : indptr)[row + 1];
           int64_t at = place[j];
-          const int64_t col0 = (int64_t)nodes[j] * bs;
-          if (a > 0 && (first + at + bs > last || indices[first + at] != col0
-                        || indices[first + at + bs - 1] != col0 + bs - 1))
+          const int64_t col0 = off ? (int64_t)ghost_column[nodes[j] - owned] : (int64_t)nodes[j] * bs;
+          if (a > 0 && (first + at + bs > last || ix[first + at] != col0
+                        || ix[first + at + bs - 1] != col0 + bs - 1))
           {
             /* this row's columns are not laid out as the node's first row's */
-            const int64_t p = find(indices, first, last, col0);
-            if (p < 0 || p + bs > last || indices[p + bs - 1] != col0 + bs - 1)
+            const int64_t p = find(ix, first, last, col0);
+            if (p < 0 || p + bs > last || ix[p + bs - 1] != col0 + bs - 1)
             {
               ++missing;
               continue;
             }
             at = p - first;
           }
-          double* vj = v + at;
+          double* vj = (off ? values_o : values) + first + at;
           const double* ej = e + j * bs;
           if (!held)
             for (int64_t b = 0; b < bs; ++b)
@@ -139,15 +174,67 @@ int64_t set_constrained_diagonal(int64_t nrows, const int32_t* indptr, const int
     }
   return missing;
 }
+
+/* The upper triangle of a symmetric AIJ matrix with nodal blocks of bs rows into the values of
+   an SBAIJ matrix of the upper block pattern (bi, bj; column-major bs x bs blocks, the diagonal
+   block whole: its upper triangle and the mirror image of that). Entries
+   of the SBAIJ pattern the AIJ rows lack are set to zero. Returns the number of AIJ entries
+   right of the diagonal block that the SBAIJ pattern lacks. */
+int64_t upper_blocks(int64_t nblocks, int64_t bs, const int32_t* indptr, const int32_t* indices,
+                     const double* values, const int32_t* bi, const int32_t* bj, double* out)
+{
+  int64_t missing = 0;
+  const int64_t bb = bs * bs;
+  for (int64_t I = 0; I < nblocks; ++I)
+  {
+    const int64_t k0 = bi[I], k1 = bi[I + 1];
+    memset(out + k0 * bb, 0, (k1 - k0) * bb * sizeof(double));
+    for (int64_t a = 0; a < bs; ++a)
+    {
+      const int64_t row = I * bs + a;
+      int64_t p = indptr[row];
+      const int64_t stop = indptr[row + 1];
+      const int64_t first = I * bs;
+      while (p < stop && indices[p] < first)
+        ++p;
+      int64_t k = k0;
+      for (; p < stop; ++p)
+      {
+        const int64_t col = indices[p], J = col / bs;
+        while (k < k1 && bj[k] < J)
+          ++k;
+        if (k == k1 || bj[k] != J)
+        {
+          ++missing;
+          continue;
+        }
+        const int64_t b = col - J * bs;
+        if (J == I)
+        {
+          /* the diagonal block: its upper triangle, mirrored (as PETSc's insertion stores it) */
+          if (b >= a)
+            out[k * bb + b * bs + a] = out[k * bb + a * bs + b] = values[p];
+        }
+        else
+          out[k * bb + b * bs + a] = values[p];
+      }
+    }
+  }
+  return missing;
+}
 """
 
 _CDEF = """
 int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64_t nb, const int32_t* blocks,
                   int64_t ng, const int32_t* geometry, const double* x, const double* w, int64_t wstride,
-                  const double* c, const int32_t* indptr, const int32_t* indices, const uint8_t* constrained,
-                  int64_t bs, double* values, double* Ae, double* X, int64_t* place);
+                  const double* c, int64_t owned, const int32_t* indptr, const int32_t* indices, double* values,
+                  const int32_t* ghost_column, const int32_t* indptr_o, const int32_t* indices_o,
+                  double* values_o, const uint8_t* constrained, int64_t bs, double* ghost,
+                  const int64_t* ghost_slot, double* Ae, double* X, int64_t* place);
 int64_t set_constrained_diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices,
                                  const uint8_t* constrained, double* values);
+int64_t upper_blocks(int64_t nblocks, int64_t bs, const int32_t* indptr, const int32_t* indices,
+                     const double* values, const int32_t* bi, const int32_t* bj, double* out);
 """
 
 _MODULE = None
@@ -188,17 +275,20 @@ def compiled():
 
 
 class CellAssembler:
-    """The tangent of an FFCx bilinear form on one rank, added into the values of a SeqAIJ
-    matrix that DOLFINx made for it (its pattern; see the module's docstring).
+    """The tangent of an FFCx bilinear form, added into the values of the AIJ matrix that DOLFINx
+    made for it (its pattern; see the module's docstring): on one rank into the SeqAIJ matrix, on
+    several into the owned rows' diagonal and off-diagonal blocks of the MPIAIJ matrix, the rows
+    of ghost nodes handed back to be sent to their owners.
 
     integrals: ``(kernel address, cells, key)`` per cell integral; blocks: the space's dofmap
     (cells × nodes); geometry, x: the mesh's geometry dofmap and coordinates; constants(),
     coefficients(): the form's packed constants and its packed coefficients by key;
-    constrained: the scalar dofs of the Dirichlet conditions; bs: dofs a node; size: scalar
-    dofs (all of :func:`dolfinx_corot._dolfinx.cell_integrals`)."""
+    constrained: the local scalar dofs of the Dirichlet conditions; bs: dofs a node; size: local
+    scalar dofs, ghosts included (all of :func:`dolfinx_corot._dolfinx.cell_integrals`);
+    owned: the owned nodes (None: all); ghosts: the global index of each ghost node's first dof."""
 
     def __init__(self, integrals, blocks, geometry, x, constants, coefficients, constrained: np.ndarray, bs: int,
-                 size: int):
+                 size: int, owned: int | None = None, ghosts: np.ndarray | None = None):
         self.integrals = [(address, np.ascontiguousarray(cells, dtype=np.int32), key)
                           for address, cells, key in integrals]
         self.blocks = np.ascontiguousarray(blocks, dtype=np.int32)
@@ -209,9 +299,39 @@ class CellAssembler:
         self.bs = bs
         self.constrained = np.zeros(size, dtype=np.bool_)
         self.constrained[constrained] = True
+        self.owned = size // bs if owned is None else int(owned)
+        self.ghosts = np.zeros(0, dtype=np.int64) if ghosts is None else np.asarray(ghosts, dtype=np.int64)
+        # the cells with a ghost node: their element matrices also go to the ghost rows' owners
+        self.slots = []
+        self.ghost_cells = []
+        count = 0
+        for _, cells, _ in self.integrals:
+            touches = (self.blocks[cells] >= self.owned).any(axis=1)
+            slot = np.full(len(cells), -1, dtype=np.int64)
+            slot[touches] = np.arange(count, count + int(touches.sum()))
+            count += int(touches.sum())
+            self.slots.append(slot)
+            self.ghost_cells.append(cells[touches])
+        self.ghost_cells = np.concatenate(self.ghost_cells) if self.ghost_cells else np.zeros(0, dtype=np.int32)
 
-    def assemble(self, indptr, indices, values) -> None:
-        """values (the matrix's CSR values, zeroed) += the form's tangent; raises RuntimeError
+    def ghost_columns(self, colmap: np.ndarray) -> np.ndarray:
+        """Each ghost node's first column in the off-diagonal block whose columns are the global
+        ``colmap`` (sorted), or −1 where its dofs are not all there."""
+        at = np.searchsorted(colmap, self.ghosts)
+        ok = np.ones(len(self.ghosts), dtype=bool)
+        for b in range(self.bs):
+            pos = at + b
+            inside = pos < len(colmap)
+            ok &= inside
+            ok[inside] &= colmap[pos[inside]] == self.ghosts[inside] + b
+        return np.where(ok, at, -1).astype(np.int32)
+
+    def assemble(self, indptr, indices, values, off=None):
+        """values (the matrix's CSR values of the owned rows and owned columns, zeroed) += the
+        form's tangent; off: ``(indptr, indices, values, colmap)`` of the off-diagonal block
+        (several ranks). Returns the rows of ghost nodes as ``(rows, columns, values)`` for
+        ``MatSetValuesBlockedLocal`` (local node indices, −1 for the owned nodes' rows; values
+        row-major, constrained rows and columns zero), or None on one rank. Raises RuntimeError
         if the pattern lacks an entry the form needs."""
         module = compiled()
         ffi, lib = module.ffi, module.lib
@@ -219,27 +339,60 @@ class CellAssembler:
         def ptr(kind, a):
             return ffi.cast(kind + "*", a.ctypes.data)
 
+        null = ffi.NULL
         c = np.ascontiguousarray(self.constants(), dtype=np.float64)
         if c.size == 0:
             c = np.zeros(1)
         packed = self.coefficients()
-        n = self.blocks.shape[1] * self.bs
+        nb = self.blocks.shape[1]
+        n = nb * self.bs
         Ae = np.empty(n * n)
         X = np.empty(3 * self.geometry.shape[1])
-        place = np.empty(self.blocks.shape[1], dtype=np.int64)
+        place = np.empty(nb, dtype=np.int64)
         held = self.constrained.view(np.uint8)
+        ghost = np.zeros((len(self.ghost_cells), n * n))
+        if off is not None:
+            indptr_o, indices_o, values_o, colmap = off
+            column = self.ghost_columns(colmap)
+            off_args = (ptr("int32_t", column), ptr("int32_t", indptr_o), ptr("int32_t", indices_o),
+                        ptr("double", values_o))
+        else:
+            off_args = (null, null, null, null)
         missing = 0
-        for address, cells, key in self.integrals:
+        for (address, cells, key), slot in zip(self.integrals, self.slots):
             w = np.ascontiguousarray(packed[key], dtype=np.float64)
             if w.size == 0:
                 w = np.zeros((len(cells), 1))
-            missing += lib.add_cells(address, len(cells), ptr("int32_t", cells), self.blocks.shape[1],
-                                     ptr("int32_t", self.blocks), self.geometry.shape[1],
-                                     ptr("int32_t", self.geometry), ptr("double", self.x), ptr("double", w),
-                                     w.shape[1] if w.size else 0, ptr("double", c), ptr("int32_t", indptr),
-                                     ptr("int32_t", indices), ptr("uint8_t", held), self.bs, ptr("double", values),
+            missing += lib.add_cells(address, len(cells), ptr("int32_t", cells), nb, ptr("int32_t", self.blocks),
+                                     self.geometry.shape[1], ptr("int32_t", self.geometry), ptr("double", self.x),
+                                     ptr("double", w), w.shape[1] if w.size else 0, ptr("double", c), self.owned,
+                                     ptr("int32_t", indptr), ptr("int32_t", indices), ptr("double", values), *off_args,
+                                     ptr("uint8_t", held), self.bs, ptr("double", ghost) if ghost.size else null,
+                                     ptr("int64_t", slot) if len(self.ghost_cells) else null,
                                      ptr("double", Ae), ptr("double", X), ptr("int64_t", place))
         missing += lib.set_constrained_diagonal(len(indptr) - 1, ptr("int32_t", indptr), ptr("int32_t", indices),
                                                 ptr("uint8_t", held), ptr("double", values))
         if missing:
             raise RuntimeError(f"the matrix's pattern lacks {missing} entries of the form")
+        if off is None:
+            return None
+        columns = self.blocks[self.ghost_cells]
+        rows = np.where(columns < self.owned, -1, columns).astype(np.int32)
+        return rows, columns.astype(np.int32), ghost
+
+
+def upper_blocks(indptr, indices, values, bs: int, bi, bj, out) -> None:
+    """out (the values of an SBAIJ matrix of the upper block pattern ``bi``, ``bj``) = the upper
+    triangle of the symmetric AIJ matrix (indptr, indices, values) with nodal blocks of ``bs``;
+    raises RuntimeError where the AIJ matrix has entries right of its diagonal block that the
+    SBAIJ pattern lacks."""
+    module = compiled()
+    ffi, lib = module.ffi, module.lib
+
+    def ptr(kind, a):
+        return ffi.cast(kind + "*", a.ctypes.data)
+
+    missing = lib.upper_blocks(len(bi) - 1, bs, ptr("int32_t", indptr), ptr("int32_t", indices), ptr("double", values),
+                               ptr("int32_t", bi), ptr("int32_t", bj), ptr("double", out))
+    if missing:
+        raise RuntimeError(f"the SBAIJ pattern lacks {missing} entries of the AIJ matrix")

@@ -159,10 +159,10 @@ class System:
         self.bcs = self.model.dirichlet_bcs()
         self.A = petsc.form_matrix(self.a, self._mat_type)
         self.b = petsc.form_vector(self.L)
-        # on one rank, a large continuum's tangent is assembled into A's values by a compiled
-        # loop (:mod:`.cells`) once DOLFINx's first assembly has laid out A's pattern
+        # a large continuum's tangent is assembled into A's values by a compiled loop
+        # (:mod:`.cells`) once DOLFINx's first assembly has laid out A's pattern
         self._cells = None
-        self._cells_checked = self.comm.size > 1
+        self._cells_checked = False
 
     def _external_force(self, amplitude) -> PETSc.Vec:
         """Assembled unit external load of one amplitude (None: the loads proportional to λ)."""
@@ -397,9 +397,18 @@ class System:
 
     def _assemble_parts_matrix(self) -> None:
         if self._cells is not None:
-            with petsc.SeqAIJArrays(self.A) as (indptr, indices, values):
+            if self.comm.size == 1:
+                with petsc.SeqAIJArrays(self.A) as (indptr, indices, values):
+                    values[:] = 0.0
+                    self._cells.assemble(indptr, indices, values)
+                return
+            with petsc.MPIAIJArrays(self.A) as ((indptr, indices, values), (ip, ix, v), colmap):
                 values[:] = 0.0
-                self._cells.assemble(indptr, indices, values)
+                v[:] = 0.0
+                rows, columns, ghost = self._cells.assemble(indptr, indices, values, (ip, ix, v, colmap))
+            if len(rows):  # the rows of ghost nodes, to their owners
+                self.A.setValuesBlockedLocalRCV(rows, columns, ghost, addv=PETSc.InsertMode.ADD_VALUES)
+            self.A.assemble()
             return
         self.A.zeroEntries()
         _dolfinx.assemble_matrix_with_bcs(self.A, self.a, self.bcs, self._test_space)
@@ -410,24 +419,30 @@ class System:
 
     def _cell_assembler(self):
         """The compiled assembly of the parts' tangent (:mod:`.cells`), or None where DOLFINx's
-        stays: several ranks, forms other than FFCx forms of cell integrals, small meshes.
-        Contributions (contact) merge their couplings into A's pattern, so that a node's rows
-        may differ in their columns: the loop checks each row's layout."""
-        if self.A.getType() != "seqaij" or np.dtype(PETSc.IntType) != np.int32:
-            return None
-        parts = _dolfinx.cell_integrals(self.a, self.bcs)
-        if parts is None:
-            return None
+        stays: forms other than FFCx forms of cell integrals, small meshes, int64 indices (the
+        same choice on every rank: both assemblies communicate the rows of ghost nodes, each in
+        its own calls). Contributions (contact) merge their couplings into A's pattern, so that a
+        node's rows may differ in their columns: the loop checks each row's layout."""
         from . import cells
 
-        if sum(len(c) for _, c, _ in parts[0]) < cells.MIN_CELLS:
-            return None
+        parts = None
         try:
-            cells.compiled()
-        except Exception as err:  # no compiler or no writable cache: DOLFINx's assembly stays
+            if self.A.getType() in ("seqaij", "mpiaij") and np.dtype(PETSc.IntType) == np.int32:
+                parts = _dolfinx.cell_integrals(self.a, self.bcs)
+            ok = parts is not None and sum(len(c) for _, c, _ in parts[0]) >= cells.MIN_CELLS
+            if ok:
+                cells.compiled()
+        except Exception as err:  # e.g. no compiler or no writable cache: DOLFINx's assembly stays
             logger.warning("the compiled tangent assembly is not available (%s); DOLFINx assembles it", err)
+            ok = False
+        space = self.a.function_spaces[0]
+        im, bs = space.dofmap.index_map, space.dofmap.index_map_bs
+        if self.comm.size > 1:
+            ok = bool(self.comm.allreduce(int(ok), op=MPI.MIN))
+        if not ok:
             return None
-        return cells.CellAssembler(*parts, size=self.A.getSize()[0])
+        return cells.CellAssembler(*parts, size=(im.size_local + im.num_ghosts) * bs, owned=im.size_local,
+                                   ghosts=np.asarray(im.ghosts, dtype=np.int64) * bs)
 
     def jacobian(self) -> None:
         """Assemble the tangent K = ∂f_int/∂x (parts and contributions), identity rows/columns on

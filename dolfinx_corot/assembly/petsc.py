@@ -188,11 +188,10 @@ class SymmetricBlockOperator:
         self.serial = A.comm.size == 1 and A.getType() == "seqaij"
         if self.serial:
             with SeqAIJArrays(A, write=False) as (indptr, indices, _):
-                self.bi, self.bj = self._upper_blocks(indptr, indices, bs, start // bs)
+                self.bi, self.bj = self._upper_blocks([(indptr, indices, None)], bs, start // bs)
         else:
-            indptr, indices, _ = A.getValuesCSR()  # global columns
-            self.bi, self.bj = self._upper_blocks(indptr, indices, bs, start // bs)
-            del indptr, indices, _
+            with MPIAIJArrays(A, write=False) as ((indptr, indices, _), (ip, ix, _o), colmap):
+                self.bi, self.bj = self._upper_blocks([(indptr, indices, start), (ip, ix, colmap)], bs, start // bs)
         S = PETSc.Mat().createSBAIJ(A.getSizes(), bs, csr=(self.bi, self.bj), comm=A.comm)
         S.setOption(PETSc.Mat.Option.IGNORE_LOWER_TRIANGULAR, True)
         S.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
@@ -212,23 +211,37 @@ class SymmetricBlockOperator:
                 pass
 
     @staticmethod
-    def _upper_blocks(indptr: np.ndarray, indices: np.ndarray, bs: int, first_block: int):
+    def _upper_blocks(parts, bs: int, first_block: int, chunk: int = 4096):
         """Block CSR (local block rows, global block columns ≥ the row's) of the nodal pattern
-        read off each block's first row."""
-        nb = (len(indptr) - 1) // bs
-        starts = indptr[:-1:bs][:nb].astype(np.int64)
-        lengths = indptr[1::bs][:nb].astype(np.int64) - starts
-        total = int(lengths.sum())
-        row = np.repeat(np.arange(nb, dtype=np.int64), lengths)
-        offset = np.arange(total, dtype=np.int64) - np.repeat(np.cumsum(lengths) - lengths, lengths)
-        block = indices[starts[row] + offset] // bs
-        del offset
-        keep = block >= row + first_block
-        keep[1:] &= (block[1:] != block[:-1]) | (row[1:] != row[:-1])
-        counts = np.bincount(row[keep], minlength=nb)
+        read off each block's first row, from the CSR ``parts`` of A's owned rows: (indptr,
+        indices, g) with g the offset of their global columns (an int) or the global column of
+        each index (an array), or None for global indices; ``chunk`` block rows at a time, so
+        that the work arrays stay small beside A."""
+        nb = (len(parts[0][0]) - 1) // bs
+        counts, columns = np.zeros(nb, dtype=np.int64), []
+        for lo in range(0, nb, chunk):
+            hi = min(lo + chunk, nb)
+            first = np.arange(lo, hi, dtype=np.int64) * bs
+            rows, cols = [], []
+            for indptr, indices, g in parts:
+                starts = indptr[first].astype(np.int64)
+                lengths = indptr[first + 1].astype(np.int64) - starts
+                at = np.repeat(starts - np.cumsum(lengths) + lengths, lengths) + np.arange(int(lengths.sum()))
+                c = indices[at].astype(np.int64)
+                cols.append(c if g is None else (c + g if np.isscalar(g) else np.asarray(g, np.int64)[c]))
+                rows.append(np.repeat(np.arange(lo, hi, dtype=np.int64), lengths))
+            row, col = np.concatenate(rows), np.concatenate(cols)
+            if len(parts) > 1:
+                order = np.lexsort((col, row))
+                row, col = row[order], col[order]
+            block = col // bs
+            keep = block >= row + first_block
+            keep[1:] &= (block[1:] != block[:-1]) | (row[1:] != row[:-1])
+            counts[lo:hi] = np.bincount(row[keep] - lo, minlength=hi - lo)
+            columns.append(block[keep].astype(PETSc.IntType))
         bi = np.zeros(nb + 1, dtype=PETSc.IntType)
         np.cumsum(counts, out=bi[1:])
-        return bi, block[keep].astype(PETSc.IntType)
+        return bi, np.concatenate(columns) if columns else np.zeros(0, dtype=PETSc.IntType)
 
     def refresh(self) -> None:
         """S = A's upper triangle, if A changed since the last refresh."""

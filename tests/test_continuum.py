@@ -373,17 +373,26 @@ def test_compiled_assembly_is_dolfinx_assembly_bit_for_bit(monkeypatch, cell, de
     system.destroy()
 
 
-@pytest.mark.parametrize("n, degree", [((6, 2, 2), 1), ((3, 1, 1), 2)], ids=["hex-Q1", "hex-Q2"])
+@pytest.mark.parametrize("n, degree", [((6, 2, 2), 1), ((3, 1, 1), 2), ((6, 3), 2)],
+                         ids=["hex-Q1", "hex-Q2", "plane-Q2"])
 def test_cg_reads_the_tangent_s_upper_triangle_in_nodal_blocks(n, degree):
-    """The iterative solver's operator is the upper triangle of the AIJ tangent in 3 × 3 blocks
-    (SBAIJ; AMG is built from the AIJ matrix): at a deformed state with supports it holds the
-    values PETSc's own conversion gives, to the last bit, and so acts as the AIJ tangent does;
-    it is copied again only when the tangent has changed; and the Newton path with it ends
-    where the path with the AIJ operator ends, in as many Krylov iterations."""
+    """The iterative solver's operator is the upper triangle of the AIJ tangent in nodal blocks
+    (SBAIJ, 3 × 3 in 3D, 2 × 2 in plane strain; AMG is built from the AIJ matrix): at a deformed
+    state with supports it holds the values PETSc's own conversion gives, to the last bit, and so
+    acts as the AIJ tangent does; it is copied again only when the tangent has changed; and the
+    Newton path with it ends where the path with the AIJ operator ends, in as many Krylov
+    iterations."""
     from dolfinx_corot.assembly import petsc
 
-    sc = _deformed_block("hexahedron", degree, dc.SaintVenantKirchhoff(1e5, 0.3), n=n)
+    if len(n) == 3:
+        sc = _deformed_block("hexahedron", degree, dc.SaintVenantKirchhoff(1e5, 0.3), n=n)
+    else:
+        sc = dc.Scene(linear_solver="iterative")
+        b = sc.add_solid(_rectangle(*n, True), material=dc.NeoHookean(E, 0.3), degree=degree)
+        sc.fix(b, "left")
+        sc.load(b, "right", traction=(0.0, -1.0))
     system = make_system(sc.model, solver="iterative")
+    assert system.A.getBlockSize() == len(n)
     rng = np.random.default_rng(3)
     _move_to(system, sc.model, 0.01 * rng.normal(size=sc.model.state.x.array.size))
     system.residual(0.5)

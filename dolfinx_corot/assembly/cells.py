@@ -313,6 +313,9 @@ class CellAssembler:
             self.slots.append(slot)
             self.ghost_cells.append(cells[touches])
         self.ghost_cells = np.concatenate(self.ghost_cells) if self.ghost_cells else np.zeros(0, dtype=np.int32)
+        # their rows and columns for MatSetValuesBlockedLocal: the rows of owned nodes left out (−1)
+        self._ghost_columns = self.blocks[self.ghost_cells]
+        self._ghost_rows = np.where(self._ghost_columns < self.owned, -1, self._ghost_columns).astype(np.int32)
 
     def ghost_columns(self, colmap: np.ndarray) -> np.ndarray:
         """Each ghost node's first column in the off-diagonal block whose columns are the global
@@ -376,9 +379,7 @@ class CellAssembler:
             raise RuntimeError(f"the matrix's pattern lacks {missing} entries of the form")
         if off is None:
             return None
-        columns = self.blocks[self.ghost_cells]
-        rows = np.where(columns < self.owned, -1, columns).astype(np.int32)
-        return rows, columns.astype(np.int32), ghost
+        return self._ghost_rows, self._ghost_columns, ghost
 
 
 def upper_blocks(indptr, indices, values, bs: int, bi, bj, out) -> None:

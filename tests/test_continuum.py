@@ -379,9 +379,7 @@ def test_cg_reads_the_tangent_s_upper_triangle_in_nodal_blocks(n, degree):
     """The iterative solver's operator is the upper triangle of the AIJ tangent in nodal blocks
     (SBAIJ, 3 × 3 in 3D, 2 × 2 in plane strain; AMG is built from the AIJ matrix): at a deformed
     state with supports it holds the values PETSc's own conversion gives, to the last bit, and so
-    acts as the AIJ tangent does; it is copied again only when the tangent has changed; and the
-    Newton path with it ends where the path with the AIJ operator ends, in as many Krylov
-    iterations."""
+    acts as the AIJ tangent does; and it is copied again only when the tangent has changed."""
     from dolfinx_corot.assembly import petsc
 
     if len(n) == 3:
@@ -423,6 +421,12 @@ def test_cg_reads_the_tangent_s_upper_triangle_in_nodal_blocks(n, degree):
     assert z.norm() <= 1e-14 * y.norm()
     petsc.destroy(op, reference, *dense, x, y, z)
     system.destroy()
+
+
+def test_the_newton_path_on_the_block_operator_is_the_path_on_the_aij_tangent():
+    """The bent cantilever block with CG on the tangent's upper triangle in nodal blocks (the
+    default) and with CG on the AIJ tangent (``-dc_newton_block_operator false``): the same tip
+    to 1e-8 in as many Krylov iterations (within 2: the products' round-off differs)."""
     tips, krylov = {}, {}
     for name, value in (("blocks", "true"), ("aij", "false")):
         options = PETSc.Options()
@@ -432,8 +436,6 @@ def test_cg_reads_the_tangent_s_upper_triangle_in_nodal_blocks(n, degree):
             system = make_system(sc.model, solver="iterative")
         finally:
             del options["dc_newton_block_operator"]
-        assert (system.linear.ksp.getOperators()[0].getType().endswith("sbaij")) == (name == "blocks") or \
-            system.linear.operator is None
         res = dc.solve(sc, dc.LoadControl(steps=2, extrapolate=True), system=system)
         assert (system.linear.operator is not None) == (name == "blocks")
         assert system.linear.ksp.getOperators()[0].getType().endswith("sbaij") == (name == "blocks")

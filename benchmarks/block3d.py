@@ -65,6 +65,7 @@ def main():
             "dofs": int(scene.model.V.dofmap.index_map.size_global * 3), "steps": len(res.history),
             "newton_iterations": it, "forcing": args.forcing, "extrapolate": args.extrapolate, "rtol": args.rtol,
             "block_operator": system.linear.operator is not None,
+            "amg_builds": system.amg_builds + 1, "amg_corotations": system.amg_corotations,
             "krylov_iterations": system.krylov_iterations, "fallback_solves": system.fallback_solves, "wall_s": wall, "setup_s": t_setup, "assembly_s": tm_.assembly,
             "solve_s": tm_.solve, "assembly_per_iteration_s": tm_.assembly / it, "solve_per_iteration_s": tm_.solve / it,
             "last_krylov_iterations": ksp_its, "peak_rss_MB_all_ranks": rss,

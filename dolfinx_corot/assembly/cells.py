@@ -19,7 +19,10 @@ them, so that the matrix is again DOLFINx's to the last bit.
 
 The same library copies a symmetric AIJ matrix's upper triangle into an SBAIJ matrix of its
 nodal blocks (:func:`upper_blocks`; the operator of the iterative solver,
-:class:`~dolfinx_corot.assembly.petsc.SymmetricBlockOperator`).
+:class:`~dolfinx_corot.assembly.petsc.SymmetricBlockOperator`), and holds the loops of the
+co-rotated AMG hierarchy (:mod:`dolfinx_corot.assembly.amg`: the patches' moments
+``patch_moments``, the check ``unlike_rows`` and the rotation ``rotate_rows`` of a
+prolongator's nodal rows).
 
 Used by :class:`~dolfinx_corot.assembly.system.System` for FFCx forms whose integrals are all
 cell integrals over meshes of at least :data:`MIN_CELLS` cells (on every rank).
@@ -222,6 +225,84 @@ int64_t upper_blocks(int64_t nblocks, int64_t bs, const int32_t* indptr, const i
   }
   return missing;
 }
+/* H_i += sum over the cells c around node i (i < n) of sum_j (b_j - mean_c b)(a_j - mean_c a)^T, for
+   positions a (before) and b (after), (nodes, d) row-major; H: (n, d, d), zeroed by the caller. */
+void patch_moments(int64_t ncells, int64_t k, const int32_t* cells, int64_t d, const double* a,
+                   const double* b, int64_t n, double* H)
+{
+  double M[9], ma[3], mb[3];
+  for (int64_t c = 0; c < ncells; ++c)
+  {
+    const int32_t* nodes = cells + c * k;
+    for (int64_t p = 0; p < d; ++p)
+      ma[p] = mb[p] = 0.0;
+    for (int64_t j = 0; j < k; ++j)
+      for (int64_t p = 0; p < d; ++p)
+      {
+        ma[p] += a[(int64_t)nodes[j] * d + p];
+        mb[p] += b[(int64_t)nodes[j] * d + p];
+      }
+    for (int64_t p = 0; p < d; ++p)
+    {
+      ma[p] /= (double)k;
+      mb[p] /= (double)k;
+    }
+    for (int64_t p = 0; p < d * d; ++p)
+      M[p] = 0.0;
+    for (int64_t j = 0; j < k; ++j)
+    {
+      const double* aj = a + (int64_t)nodes[j] * d;
+      const double* bj = b + (int64_t)nodes[j] * d;
+      for (int64_t p = 0; p < d; ++p)
+        for (int64_t q = 0; q < d; ++q)
+          M[p * d + q] += (bj[p] - mb[p]) * (aj[q] - ma[q]);
+    }
+    for (int64_t j = 0; j < k; ++j)
+      if (nodes[j] < n)
+        for (int64_t p = 0; p < d * d; ++p)
+          H[(int64_t)nodes[j] * d * d + p] += M[p];
+  }
+}
+
+/* The rows of each node (bs of them, node i: rows i*bs ... i*bs + bs - 1) that do not hold the
+   same columns in the same order: their number. */
+int64_t unlike_rows(int64_t nodes, int64_t bs, const int32_t* indptr, const int32_t* indices)
+{
+  int64_t unlike = 0;
+  for (int64_t i = 0; i < nodes; ++i)
+  {
+    const int64_t r0 = i * bs, len = indptr[r0 + 1] - indptr[r0];
+    for (int64_t a = 1; a < bs; ++a)
+    {
+      const int64_t ra = r0 + a;
+      int same = indptr[ra + 1] - indptr[ra] == len;
+      for (int64_t k = 0; same && k < len; ++k)
+        same = indices[indptr[ra] + k] == indices[indptr[r0] + k];
+      unlike += !same;
+    }
+  }
+  return unlike;
+}
+
+/* values = diag(R_i) base on CSR rows grouped by node (rows alike: unlike_rows == 0):
+   row i*bs + a = sum_b R_i[a][b] row i*bs + b, R: (nodes, bs, bs) row-major. */
+void rotate_rows(int64_t nodes, int64_t bs, const int32_t* indptr, const double* base, const double* R,
+                 double* values)
+{
+  for (int64_t i = 0; i < nodes; ++i)
+  {
+    const int64_t r0 = i * bs, len = indptr[r0 + 1] - indptr[r0];
+    const double* Ri = R + i * bs * bs;
+    for (int64_t k = 0; k < len; ++k)
+      for (int64_t a = 0; a < bs; ++a)
+      {
+        double sum = 0.0;
+        for (int64_t b = 0; b < bs; ++b)
+          sum += Ri[a * bs + b] * base[indptr[r0 + b] + k];
+        values[indptr[r0 + a] + k] = sum;
+      }
+  }
+}
 """
 
 _CDEF = """
@@ -235,6 +316,11 @@ int64_t set_constrained_diagonal(int64_t nrows, const int32_t* indptr, const int
                                  const uint8_t* constrained, double* values);
 int64_t upper_blocks(int64_t nblocks, int64_t bs, const int32_t* indptr, const int32_t* indices,
                      const double* values, const int32_t* bi, const int32_t* bj, double* out);
+void patch_moments(int64_t ncells, int64_t k, const int32_t* cells, int64_t d, const double* a,
+                   const double* b, int64_t n, double* H);
+int64_t unlike_rows(int64_t nodes, int64_t bs, const int32_t* indptr, const int32_t* indices);
+void rotate_rows(int64_t nodes, int64_t bs, const int32_t* indptr, const double* base, const double* R,
+                 double* values);
 """
 
 _MODULE = None

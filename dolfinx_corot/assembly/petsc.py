@@ -442,10 +442,12 @@ class LinearSolver:
     """K x = b with the last tangent: MUMPS (``iterative=False``) or CG/GMRES + AMG.
 
     symmetric: LDLᵀ (MUMPS) and CG; nullspace: the rigid-body modes for AMG;
-    fixed_rtol: a linear problem (no adaptive forcing)."""
+    fixed_rtol: a linear problem (no adaptive forcing); prolongator: the class that takes the
+    finest prolongator of a new GAMG hierarchy to co-rotate it, ``(pc, block size)``
+    (:class:`dolfinx_corot.assembly.amg.CorotatedProlongator`; None: hierarchies built anew)."""
 
     def __init__(self, comm, A: PETSc.Mat, iterative: bool, symmetric: bool, options_prefix: str = "dc_newton_",
-                 nullspace: PETSc.NullSpace | None = None, fixed_rtol: bool = False):
+                 nullspace: PETSc.NullSpace | None = None, fixed_rtol: bool = False, prolongator=None):
         self.comm = comm
         self.A = A
         self.iterative = iterative
@@ -460,7 +462,8 @@ class LinearSolver:
             # CG + PETSc's smoothed-aggregation AMG (GAMG) with the rigid-body near-nullspace
             # (of the current configuration: System.reuse_preconditioner), one Chebyshev–Jacobi
             # sweep before and after the coarse correction, couplings weaker than 2 % dropped
-            # from the aggregation graph, the hierarchy rebuilt at each step's first tangent. On
+            # from the aggregation graph, the hierarchy kept from step to step with its finest
+            # prolongator co-rotated (System._refresh_amg, assembly/amg.py) or rebuilt. On
             # the 116 k-dof SVK block against ML (Trilinos) on a BAIJ copy: half the peak memory
             # (384 against 750 MB; ML's hierarchy alone took 318 MB, GAMG's 55 MB); AMG reads
             # the AIJ matrix the tangent is assembled into, CG and the smoothers its upper
@@ -491,6 +494,14 @@ class LinearSolver:
         self.operator: SymmetricBlockOperator | None = None
         self._block_operator = (iterative and symmetric and A.getBlockSize() > 1
                                 and PETSc.Options().getBool(options_prefix + "block_operator", True))
+        # the AMG hierarchy kept from step to step, its finest prolongator co-rotated
+        # (:mod:`dolfinx_corot.assembly.amg`; ``-<prefix>amg_corotate false``: built anew each time)
+        self.prolongator = None
+        self._prolongator_type = prolongator
+        self.corotation = (iterative and prolongator is not None
+                           and PETSc.Options().getBool(options_prefix + "amg_corotate", True))
+        self._take_prolongator = self.corotation
+        self.solves = 0  # iterative solves
         self.mumps = self.ksp.getType() == "preonly" and pc.getType() in ("lu", "cholesky") \
             and pc.getFactorSolverType() == "mumps"
         self.ldlt = self.mumps and pc.getType() == "cholesky"
@@ -546,12 +557,16 @@ class LinearSolver:
         reason = self.ksp.getConvergedReason()
         if self.iterative:
             self.krylov_iterations += self.ksp.getIterationNumber()
+            self.solves += 1
+            if self._take_prolongator and reason >= 0:
+                self._keep_prolongator()
         if reason < 0 and self.iterative:
             # CG + GAMG fails on an indefinite tangent (past a bifurcation or a limit point):
             # this solve is repeated with a sparse LU (MUMPS); the next ones try CG again
             logger.warning("CG + GAMG failed (PETSc reason %d after %d iterations): solving with MUMPS LU",
                            reason, self.ksp.getIterationNumber())
             reason = self._direct_solve(rhs, out)
+            self.prolongator = None  # the next hierarchy is built anew
         if reason < 0:
             raise np.linalg.LinAlgError(f"linear solve failed (PETSc reason {reason}); "
                                         "the tangent may be singular (a missing support?)")
@@ -600,6 +615,37 @@ class LinearSolver:
             pc.setType("none")
             pc.setType("gamg")
             pc.setFromOptions()
+        self.prolongator = None
+        self._take_prolongator = self.corotation
+
+    def _keep_prolongator(self) -> None:
+        """After the first solve with a new GAMG hierarchy: its finest prolongator, to be
+        co-rotated (:meth:`corotate`); none where it cannot be."""
+        self._take_prolongator = False
+        pc = self.ksp.getPC()
+        if pc.getType() != "gamg":
+            return
+        try:
+            self.prolongator = self._prolongator_type(pc, self.A.getBlockSize())
+        except ValueError as err:
+            logger.debug("the AMG hierarchy is built anew at each step: %s", err)
+            self.prolongator = None
+
+    def corotate(self, rotations: np.ndarray) -> bool:
+        """Keep the AMG hierarchy for the next tangents, its finest prolongator turned by the
+        nodal rotations since it was built (``rotations``: (owned nodes, bs, bs)); its next set-up
+        makes the Galerkin products only. False (nothing done) where there is no such hierarchy:
+        none yet, built anew by PETSc since (a new pattern), or not of nodal rows."""
+        pc = self.ksp.getPC()
+        if self.prolongator is None or not self.prolongator.current(pc):
+            self.prolongator = None
+            return False
+        self.prolongator.rotate(rotations)
+        # GAMG's next set-ups keep its prolongators: the Galerkin products only
+        ctypes, lib, _, _ = _petsc_library()
+        if lib.PCGAMGSetReuseInterpolation(ctypes.c_void_p(pc.handle), ctypes.c_int(1)):
+            raise RuntimeError("PCGAMGSetReuseInterpolation failed")
+        return True
 
     def reuse_preconditioner(self, reuse: bool) -> None:
         """Keep the preconditioner of an earlier tangent for the next iterative solves."""

@@ -145,10 +145,21 @@ class System:
         if self.iterative:
             nullspace = petsc.near_nullspace(self.comm, model.V.dofmap.index_map, model.V.dofmap.index_map_bs,
                                              model.near_nullspace_modes())
+        prolongator = None
+        if self.iterative and model.large_rotations and hasattr(model, "patch_rotations"):
+            from .amg import CorotatedProlongator as prolongator
         self.linear = petsc.LinearSolver(self.comm, self.A, self.iterative, symmetric, options_prefix, nullspace,
-                                         fixed_rtol=not model.large_rotations)
+                                         fixed_rtol=not model.large_rotations, prolongator=prolongator)
         self._current_modes = self.iterative and model.large_rotations
         self._modes_version = self._version
+        # the AMG hierarchy: the positions it was built at, and whether the configuration has
+        # changed since its last set-up (see reuse_preconditioner)
+        self._amg_stale = False
+        self._amg_built_at = model.positions().copy() if self._current_modes and hasattr(model, "positions") else None
+        self._amg_period = (0, 0)  # (Krylov iterations, solves) when the last set-up was decided
+        self._amg_reference = None  # CG iterations a solve in the first period after a build
+        self.amg_builds = 0  # hierarchies built anew at a new configuration (the first one not counted)
+        self.amg_corotations = 0  # hierarchies kept and co-rotated
         self._fields_setup()
         self._choose_tangent()
 
@@ -520,6 +531,8 @@ class System:
         t = time.perf_counter()
         try:
             self._choose_factorization()
+            if self._amg_stale:
+                self._refresh_amg()
             self.linear.solve(rhs, out)
         finally:
             self.timings.solve += time.perf_counter() - t
@@ -624,10 +637,41 @@ class System:
         a third fewer CG iterations)."""
         if not reuse and self._current_modes and self._modes_version != self._version:
             self._modes_version = self._version
-            model = self.model
-            self.linear.set_near_nullspace(petsc.near_nullspace(
-                self.comm, model.V.dofmap.index_map, model.V.dofmap.index_map_bs, model.near_nullspace_modes()))
+            self._amg_stale = True  # decided at the next solve
         self.linear.reuse_preconditioner(reuse)
+
+    def _refresh_amg(self) -> None:
+        """The AMG hierarchy for a new configuration, before the solve that sets it up: kept
+        and co-rotated (:mod:`dolfinx_corot.assembly.amg`: its finest prolongator turned by
+        the nodal rotations since it was built, the Galerkin products made anew on their
+        pattern), or built anew with the rigid-body modes of the current configuration. Anew
+        when there is none to keep, and when its CG iterations a solve since the last decision
+        exceed 1.5 times (+ 2) those of the first period after its build: the co-rotation follows
+        the material's rotation, not the change of its strain and stress."""
+        self._amg_stale = False
+        model, linear = self.model, self.linear
+        its, solves = linear.krylov_iterations, linear.solves
+        period = ((its - self._amg_period[0]) / (solves - self._amg_period[1])
+                  if solves > self._amg_period[1] else None)
+        self._amg_period = (its, solves)
+        if self._amg_reference is None:
+            self._amg_reference = period
+        grown = (period is not None and self._amg_reference is not None
+                 and period > 1.5 * self._amg_reference + 2.0)
+        kept = linear.prolongator is not None and linear.prolongator.current(linear.ksp.getPC())
+        if (self._amg_built_at is not None and not grown and self.comm.allreduce(kept, op=MPI.LAND)
+                and linear.corotate(model.patch_rotations(self._amg_built_at))):
+            self.amg_corotations += 1
+            return
+        if grown:
+            logger.debug("AMG built anew: %.1f CG iterations a solve against %.1f after its last build",
+                         period, self._amg_reference)
+        linear.set_near_nullspace(petsc.near_nullspace(
+            self.comm, model.V.dofmap.index_map, model.V.dofmap.index_map_bs, model.near_nullspace_modes()))
+        if self._amg_built_at is not None:
+            self._amg_built_at = model.positions().copy()
+        self._amg_reference = None
+        self.amg_builds += 1
 
     def negative_eigenvalues(self) -> int | None:
         return self.linear.negative_eigenvalues()

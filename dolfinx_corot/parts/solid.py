@@ -85,7 +85,7 @@ class Solid(AdditiveState, Part):
         self.V = _dolfinx.function_space(mesh, "Lagrange", degree, mesh.geometry.dim)
         self.nodes_per_cell = self.V.dofmap.dof_layout.num_dofs  # dof blocks per cell
         self.state = dolfinx.fem.Function(self.V, name="displacement")
-        self._dof_coordinates = None  # owned dofs' reference coordinates (near-nullspace modes)
+        self._dof_coordinates = None  # the dof blocks' reference coordinates (positions)
         self.reference_shift = dolfinx.fem.Function(self.V, name="reference_shift")
         self._shifted = None
         Q = _dolfinx.function_space(mesh, "DG", 0, scalar=True)
@@ -684,6 +684,23 @@ class Solid(AdditiveState, Part):
         return np.zeros(self.V.dofmap.index_map.size_local + self.V.dofmap.index_map.num_ghosts, dtype=bool)
 
     # -- linear solver -------------------------------------------------------------
+    def positions(self) -> np.ndarray:
+        """The current positions x = X + u of all local dof blocks, ghosts included ((blocks,
+        gdim); X: the reference, shifted where a stage mapped it)."""
+        d = self.gdim
+        if self._dof_coordinates is None:
+            self._dof_coordinates = self.V.tabulate_dof_coordinates()[:, :d].copy()
+        return self._dof_coordinates + self.reference_shift.x.array.reshape(-1, d) + self.state.x.array.reshape(-1, d)
+
+    def patch_rotations(self, before: np.ndarray) -> np.ndarray:
+        """The rotation of the material around each owned dof block from positions ``before``
+        (:meth:`positions` of an earlier configuration) to the current ones: (n_owned, gdim, gdim),
+        fitted to the block's patch of cells (:func:`dolfinx_corot.assembly.amg.patch_rotations`)."""
+        from ..assembly.amg import patch_rotations
+
+        cells = self.V.dofmap.list.array.reshape(-1, self.nodes_per_cell)
+        return patch_rotations(cells, before, self.positions(), self.V.dofmap.index_map.size_local)
+
     def near_nullspace_modes(self) -> list[np.ndarray]:
         """Rigid-body modes (3 in 2D, 6 in 3D) on the owned blocks of V ((n_owned, gdim) each), the
         near-nullspace of algebraic multigrid: translations, and infinitesimal rotations of the
@@ -691,10 +708,7 @@ class Solid(AdditiveState, Part):
         which are nearly free motions of the tangent at u."""
         n_owned = self.V.dofmap.index_map.size_local
         d = self.gdim
-        if self._dof_coordinates is None:
-            self._dof_coordinates = self.V.tabulate_dof_coordinates()[:n_owned, :d].copy()
-        x = self._dof_coordinates + self.reference_shift.x.array.reshape(-1, d)[:n_owned] \
-            + self.state.x.array.reshape(-1, d)[:n_owned]
+        x = self.positions()[:n_owned]
         modes = []
         for k in range(d):
             m = np.zeros((n_owned, d))

@@ -523,34 +523,43 @@ def test_patch_rotations_recover_a_rigid_rotation_of_the_mesh(compiled, monkeypa
     assert np.abs(R2 - Q).max() < 1e-13
 
 
-@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "numpy"])
-def test_the_corotated_prolongator_is_the_built_one_turned_node_by_node(compiled, monkeypatch):
-    """The finest prolongator of the block's GAMG hierarchy, turned by a rotation a node, is
-    diag(R_i) P⁰ to round-off, on one rank and several (the off-diagonal block too), and turned
-    back by the identity it is P⁰ again, bit for bit: the rotation acts on the values kept."""
+@pytest.mark.parametrize("compiled, d", [(True, 3), (False, 3), (True, 2)], ids=["compiled", "numpy", "plane"])
+def test_the_corotated_prolongator_is_the_built_one_turned_node_by_node(compiled, d, monkeypatch):
+    """The finest prolongator of the block's GAMG hierarchy (3D, and plane strain), turned by a
+    rotation a node, is diag(R_i) P⁰ to round-off, on one rank and several (the off-diagonal
+    block too), and turned back by the identity it is P⁰ again, bit for bit: the rotation acts
+    on the values kept."""
     from dolfinx_corot.assembly import amg
 
     if not compiled:
         monkeypatch.setattr(amg, "_compiled", lambda: None)
-    sc = _cantilever_block((12, 2, 2))
-    sc.linear_solver = "iterative"
+    if d == 3:
+        sc = _cantilever_block((12, 2, 2))
+    else:
+        sc = dc.Scene()
+        b = sc.add_solid(_rectangle(24, 4, True), material=dc.NeoHookean(E, 0.3), degree=1)
+        sc.fix(b, "left")
+        sc.load(b, "right", traction=(0.0, -1.0))
     system = make_system(sc.model, solver="iterative")
     system.residual(0.0)
     system.jacobian()
     system.solve()
     pc = system.linear.ksp.getPC()
     assert pc.getMGLevels() >= 2
-    prolongator = amg.CorotatedProlongator(pc, 3)
+    prolongator = amg.CorotatedProlongator(pc, d)
     P = prolongator.P
     P0 = P.convert("dense", PETSc.Mat()).getDenseArray().copy()
-    n = system.A.getLocalSize()[0] // 3
+    n = system.A.getLocalSize()[0] // d
     rng = np.random.default_rng(comm.rank)
     R = np.array([_rotation(rng.normal(size=3), rng.uniform(0.0, 3.0)) for _ in range(n)])
+    if d == 2:
+        angle = rng.uniform(-3.0, 3.0, size=n)
+        R = np.stack([np.stack([np.cos(angle), -np.sin(angle)], -1), np.stack([np.sin(angle), np.cos(angle)], -1)], 1)
     prolongator.rotate(R)
     P1 = P.convert("dense", PETSc.Mat()).getDenseArray()
-    expected = np.einsum("nab,nbk->nak", R, P0.reshape(n, 3, -1)).reshape(P0.shape)
+    expected = np.einsum("nab,nbk->nak", R, P0.reshape(n, d, -1)).reshape(P0.shape)
     assert np.abs(P1 - expected).max() <= 1e-14 * np.abs(P0).max()
-    prolongator.rotate(np.tile(np.eye(3), (n, 1, 1)))
+    prolongator.rotate(np.tile(np.eye(d), (n, 1, 1)))
     assert np.array_equal(P.convert("dense", PETSc.Mat()).getDenseArray(), P0)
     assert prolongator.current(pc)
     system.destroy()

@@ -630,11 +630,12 @@ class System:
         self.linear.set_forcing(eta)
 
     def reuse_preconditioner(self, reuse: bool) -> None:
-        """Keep (True) or rebuild (False) the iterative solver's preconditioner for the next
-        solves. A rebuilt AMG of a large-deformation continuum gets the rigid-body modes of the
-        current configuration as its near-nullspace: a total-Lagrangian tangent is nearly
-        singular for infinitesimal rotations of x = X + u, not of X (the 116 k-dof SVK block:
-        a third fewer CG iterations)."""
+        """Keep (True) or set up anew (False) the iterative solver's preconditioner for the
+        next solves. For a large-deformation continuum at a new configuration the AMG follows
+        the rigid-body modes of the current configuration (a total-Lagrangian tangent is nearly
+        singular for infinitesimal rotations of x = X + u, not of X; the 116 k-dof SVK block: a
+        third fewer CG iterations): its hierarchy co-rotated or built anew at the next solve
+        (:meth:`_refresh_amg`)."""
         if not reuse and self._current_modes and self._modes_version != self._version:
             self._modes_version = self._version
             self._amg_stale = True  # decided at the next solve

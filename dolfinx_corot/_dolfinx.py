@@ -22,6 +22,7 @@
 """
 from __future__ import annotations
 
+import weakref
 from typing import Sequence
 
 import numpy as np
@@ -33,14 +34,20 @@ import dolfinx.fem.petsc
 import dolfinx.mesh
 
 
+# forms of compiled kernels that the compiled loop of assembly.cells may assemble: their kernel
+_CELL_KERNELS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
 def kernel_form(V: dolfinx.fem.FunctionSpace, kernel_address: int, rank: int,
                 coefficients: Sequence[dolfinx.fem.Function], constants: Sequence[dolfinx.fem.Constant],
-                cells: np.ndarray | None = None):
+                cells: np.ndarray | None = None, loop: bool = False):
     """A DOLFINx form whose cell integral is a compiled kernel.
 
     V: the argument space (test, and trial for rank 2); kernel_address: the
-    address of a numba cfunc; coefficients are packed into ``w`` in order,
-    constants into ``c``; cells: owned cells to integrate over (all if None).
+    address of a compiled kernel (a numba cfunc, a C function); coefficients are
+    packed into ``w`` in order, constants into ``c``; cells: owned cells to
+    integrate over (all if None); loop: the form's matrix may be assembled by
+    :class:`dolfinx_corot.assembly.cells.CellAssembler` (:func:`cell_integrals`).
     """
     mesh = V.mesh
     if cells is None:
@@ -51,8 +58,11 @@ def kernel_form(V: dolfinx.fem.FunctionSpace, kernel_address: int, rank: int,
         tags = dolfinx.mesh.meshtags(mesh, tdim, cells, np.ones(len(cells), dtype=np.int32))
         integrals = {dolfinx.cpp.fem.IntegralType.cell: ([(1, kernel_address)], tags)}
     spaces = [V._cpp_object] * rank
-    return dolfinx.cpp.fem.Form_float64(spaces, integrals, [c._cpp_object for c in coefficients],
+    form = dolfinx.cpp.fem.Form_float64(spaces, integrals, [c._cpp_object for c in coefficients],
                                         [c._cpp_object for c in constants], False)
+    if loop:
+        _CELL_KERNELS[form] = kernel_address
+    return form
 
 
 def index_map(comm, n_owned: int, ghosts: np.ndarray, owners: np.ndarray):
@@ -146,16 +156,17 @@ def function_space(mesh: dolfinx.mesh.Mesh, family: str, degree: int, dim: int |
 
 def cell_integrals(form, bcs: list):
     """What :class:`dolfinx_corot.assembly.cells.CellAssembler` needs to assemble an FFCx
-    bilinear form on one rank without DOLFINx: ``(integrals, blocks, geometry, x, constants,
-    coefficients, constrained, bs)``, or None for a form it does not cover (integrals other
+    bilinear form, or one of :func:`kernel_form` with ``loop``, without DOLFINx: ``(integrals,
+    blocks, geometry, x, constants, coefficients, constrained, bs)``, or None for a form it does not cover (integrals other
     than cell integrals, two different spaces, elements with dof transformations, conditions
     on another space). integrals: ``(kernel address, cells, key of the packed coefficients)``;
     constants(), coefficients(): the form's packed constants and coefficients (a dict by key)."""
     import cffi
 
     ufcx = getattr(form, "ufcx_form", None)
+    kernel = _CELL_KERNELS.get(form) if ufcx is None else None
     cell = dolfinx.cpp.fem.IntegralType.cell
-    if ufcx is None or form.rank != 2 or set(form.integral_types) != {cell}:
+    if (ufcx is None and kernel is None) or form.rank != 2 or set(form.integral_types) != {cell}:
         return None
     V0, V1 = form.function_spaces
     if V0 is not V1 and not (V0.contains(V1) and V1.contains(V0)):
@@ -164,14 +175,18 @@ def cell_integrals(form, bcs: list):
         return None
     if not all(V0.contains(bc.function_space) for bc in bcs):
         return None
-    ffi = cffi.FFI()
-    count = ufcx.num_integrals(0)
-    ids = ffi.unpack(ufcx.integral_ids(0), count)
     integrals = []
-    for k, i in enumerate(ids):
-        kernel = ufcx.integrals(0)[k].tabulate_tensor_float64
-        cells = np.asarray(form.domains(cell, i), dtype=np.int32)
-        integrals.append((int(ffi.cast("uintptr_t", kernel)), cells, (cell, i)))
+    if ufcx is None:
+        for i in form.integral_ids(cell):
+            integrals.append((kernel, np.asarray(form.domains(cell, i), dtype=np.int32), (cell, i)))
+    else:
+        ffi = cffi.FFI()
+        count = ufcx.num_integrals(0)
+        ids = ffi.unpack(ufcx.integral_ids(0), count)
+        for k, i in enumerate(ids):
+            address = ufcx.integrals(0)[k].tabulate_tensor_float64
+            cells = np.asarray(form.domains(cell, i), dtype=np.int32)
+            integrals.append((int(ffi.cast("uintptr_t", address)), cells, (cell, i)))
     mesh = V0.mesh
     geometry = mesh.geometry.dofmap.array.reshape(-1, mesh.geometry.cmap.create_dof_layout().num_dofs)
     bs = V0.dofmap.index_map_bs

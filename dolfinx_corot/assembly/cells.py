@@ -332,22 +332,44 @@ def _cache_dir() -> Path:
 
 
 def compiled():
-    """The compiled loop (cffi), built once per machine and source into the cache directory;
-    a build goes to a private directory first and is moved in whole, so that processes
-    building at once do not read each other's half-written files."""
+    """The compiled loop (cffi) of this module, built once per machine and source (:func:`build`)."""
     global _MODULE
-    if _MODULE is not None:
-        return _MODULE
+    if _MODULE is None:
+        _MODULE = build("_dc_cells_", _SOURCE, _CDEF)
+    return _MODULE
+
+
+def _processor() -> str:
+    """The processor's model and instruction sets (Linux's /proc/cpuinfo; else the platform's name)."""
+    import platform
+
+    try:
+        with open("/proc/cpuinfo") as f:
+            lines = [line for line in f if line.startswith(("model name", "flags", "Features"))]
+        return "".join(sorted(set(lines)))
+    except OSError:
+        return platform.processor() + platform.machine()
+
+
+def build(prefix: str, source: str, cdef: str, flags: tuple[str, ...] = ("-O2", "-g0")):
+    """The cffi module of C ``source`` (declarations ``cdef``), compiled with ``flags`` once per
+    machine, source and flags into the cache directory and named ``prefix`` + a hash of them; a
+    build goes to a private directory first and is moved in whole, so that processes building at
+    once do not read each other's half-written files. Code for this processor (``-march=native``)
+    is named after the processor's instruction sets as well, so that a cache directory shared by
+    different machines does not hand one another's code to the other."""
     import cffi
 
-    name = "_dc_cells_" + hashlib.sha1((_SOURCE + _CDEF + sys.version).encode()).hexdigest()[:16]
+    salt = _processor() if "-march=native" in flags else ""
+    digest = hashlib.sha1((source + cdef + " ".join(flags) + sys.version + salt).encode()).hexdigest()[:16]
+    name = prefix + digest
     cache = _cache_dir()
     cache.mkdir(parents=True, exist_ok=True)
     built = list(cache.glob(name + "*.so"))
     if not built:
         ffi = cffi.FFI()
-        ffi.cdef(_CDEF)
-        ffi.set_source(name, _SOURCE, extra_compile_args=["-O2", "-g0"])
+        ffi.cdef(cdef)
+        ffi.set_source(name, source, extra_compile_args=list(flags))
         with tempfile.TemporaryDirectory(dir=cache) as tmp:
             library = Path(ffi.compile(tmpdir=tmp, verbose=False))
             target = cache / library.name
@@ -356,7 +378,6 @@ def compiled():
     spec = importlib.util.spec_from_file_location(name, built[0])
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    _MODULE = module
     return module
 
 

@@ -633,18 +633,22 @@ class LinearSolver:
 
     def corotate(self, rotations: np.ndarray) -> bool:
         """Keep the AMG hierarchy for the next tangents, its finest prolongator turned by the
-        nodal rotations since it was built (``rotations``: (owned nodes, bs, bs)); its next set-up
-        makes the Galerkin products only. False (nothing done) where there is no such hierarchy:
-        none yet, built anew by PETSc since (a new pattern), or not of nodal rows."""
+        nodal rotations since it was built (``rotations``: (owned nodes, bs, bs)), its coarse
+        operators as they are: for a tangent that is the built one turned, K = Q K⁰ Qᵀ, the
+        Galerkin product (QP⁰)ᵀ K (QP⁰) = P⁰ᵀ K⁰ P⁰ is the one built (docs/theory.md). The
+        preconditioner is reused until it is made anew. False (nothing done) where there is no
+        such hierarchy: none yet, built anew by PETSc since (a new pattern), or not of nodal rows."""
         pc = self.ksp.getPC()
         if self.prolongator is None or not self.prolongator.current(pc):
             self.prolongator = None
             return False
         self.prolongator.rotate(rotations)
-        # GAMG's next set-ups keep its prolongators: the Galerkin products only
+        # should PETSc set the hierarchy up again (a new pattern of the same operator), it keeps
+        # the turned prolongators and makes the Galerkin products only
         ctypes, lib, _, _ = _petsc_library()
         if lib.PCGAMGSetReuseInterpolation(ctypes.c_void_p(pc.handle), ctypes.c_int(1)):
             raise RuntimeError("PCGAMGSetReuseInterpolation failed")
+        pc.setReusePreconditioner(True)
         return True
 
     def reuse_preconditioner(self, reuse: bool) -> None:

@@ -644,8 +644,7 @@ class System:
     def _refresh_amg(self) -> None:
         """The AMG hierarchy for a new configuration, before the solve that sets it up: kept
         and co-rotated (:mod:`dolfinx_corot.assembly.amg`: its finest prolongator turned by
-        the nodal rotations since it was built, the Galerkin products made anew on their
-        pattern), or built anew with the rigid-body modes of the current configuration. Anew
+        the nodal rotations since it was built, its coarse operators kept), or built anew with the rigid-body modes of the current configuration. Anew
         when there is none to keep, and when its CG iterations a solve since the last decision
         exceed 1.5 times (+ 2) those of the first period after its build: the co-rotation follows
         the material's rotation, not the change of its strain and stress."""

@@ -601,9 +601,35 @@ class Solid(AdditiveState, Part):
         if np.any(self.nu.x.array >= 0.5) or np.any(self.E.x.array <= 0.0):
             raise ValueError("solid: E must be positive and nu below 0.5 in every cell")
 
+    def _compiled_forms(self):
+        """(residual, tangent) of the C kernels of :mod:`dolfinx_corot.continuum.compiled`
+        (the same integrals as the UFL forms, about 3 × faster), or None where they do not cover
+        the forms: small strains, staged cells, initial stresses, a captured reference, follower
+        pressures, or no C compiler."""
+        if (not self.large_rotations or self.existing is not None or self.initial_stress is not None
+                or self._shifted or self._follower_pressures):
+            return None
+        from ..continuum import compiled
+
+        mesh = self.V.mesh
+        try:
+            residual, tangent = compiled.kernels(self.law, mesh.topology.cell_name(), self.degree,
+                                                 mesh.geometry.cmap.degree, self.quadrature)
+        except Exception as err:  # no compiler, no writable cache: FFCx's kernels
+            import logging
+
+            logging.getLogger(__name__).warning("compiled continuum kernels not available (%s); "
+                                                "FFCx's kernels are used", err)
+            return None
+        w = [self.state, self.E, self.nu]
+        return (_dolfinx.kernel_form(self.V, residual, 1, w, []),
+                _dolfinx.kernel_form(self.V, tangent, 2, w, [], loop=True))
+
     def forms(self):
         if self._forms is None:
             self._check_complete()
+            self._forms = self._compiled_forms()
+        if self._forms is None:
             u, v, du = self.state, ufl.TestFunction(self.V), ufl.TrialFunction(self.V)
             dx = ufl.dx(metadata={"quadrature_degree": self.quadrature})
             if self.existing is not None:

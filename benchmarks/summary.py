@@ -25,7 +25,7 @@ PEERS = {
     "45deg_bend": "OpenSeesPy 0.08 s whole process (0.021 s in the solver), 36 MB; Kratos 0.14 s, 79 MB",
     "pullout": "CalculiX S4 (36 × 24) 13–14 s, w_A −1.6 %; OpenSees ShellNLDKGQ 147 s, w_A −4.4 %",
     "hertz_same": "CalculiX CPE8 (another set-up) 22–25 s",
-    "block3d": "116 k dofs: Kratos (AMGCL) 78–109 s, 633 MB; CalculiX (iterative) 80–105 s, 249 MB (on a twice faster machine); CalculiX 2.20 here (benchmarks/block_calculix.py): 159 s, 249 MB",
+    "block3d": "116 k dofs: Kratos (AMGCL) 78–109 s, 633 MB; CalculiX (iterative) 80–105 s, 249 MB (on a twice faster machine); here, in one sitting with ours at 13.0–13.5 s, 379 MB (session 50): CalculiX 2.20 (benchmarks/block_calculix.py) 146 s, 249 MB; Kratos 10.4 (benchmarks/block_kratos.py, AMGCL with Kratos's defaults) 136 s, 598 MB",
 }
 
 

@@ -3,10 +3,14 @@
 DOLFINx 0.5.2 inserts each element matrix through ``MatSetValuesLocal``, which searches its
 row for every column: for trilinear hexahedra with three dofs a node (24 × 24 element
 matrices) that costs as much as the FFCx kernel itself. Here a small C loop (compiled by cffi
-on first use, as FFCx compiles forms, and cached on disk) calls the form's FFCx kernel cell by
-cell and adds each 3 × 3 nodal block where it lies in the row: the column's place is found
-once per pair of nodes, by bisection in the row's sorted columns, and serves the block's other
-rows wherever their columns are laid out alike (checked; otherwise they are searched too).
+on first use, as FFCx compiles forms, and cached on disk) calls the form's kernel (FFCx's or
+:mod:`dolfinx_corot.continuum.compiled`'s) cell by cell and adds each 3 × 3 nodal block where it
+lies in the row: the column's place is found once per pair of nodes, by bisection in the row's
+sorted columns, and serves the block's other rows wherever their columns are laid out alike
+(checked; otherwise they are searched too). The places are kept for the next tangents (a map of
+4 bytes per pair of a cell's nodes, about 8 % of the AIJ matrix for trilinear hexahedra), checked at
+each use against the row's columns, and searched again where the pattern has changed (contact
+couplings merged into it).
 Rows and columns of constrained dofs are left out and their diagonal set to 1, as DOLFINx's
 ``assemble_matrix`` with Dirichlet conditions and ``insert_diagonal`` do; the entries are
 added in DOLFINx's order, so the matrix is the same to the last bit.
@@ -66,13 +70,16 @@ static int64_t find(const int32_t* indices, int64_t lo, int64_t hi, int64_t colu
    (several ranks: PETSc's off-diagonal block). The element matrix of the k-th cell goes whole
    to ghost + ghost_slot[k] * n * n as well where ghost_slot[k] >= 0 (its rows of ghost nodes are
    sent to their owners by the caller). Rows and columns of constrained dofs are left out (zero in
-   the copy). Returns the number of entries the pattern lacks. */
+   the copy). map (or NULL): for each cell and pair of its nodes (i, j), the place of node j's first
+   column in node i's first row (from the row's start; -1: not known), kept from call to call and
+   checked at each use (a new pattern is searched again). Returns the number of entries the pattern
+   lacks. */
 int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64_t nb, const int32_t* blocks,
                   int64_t ng, const int32_t* geometry, const double* x, const double* w, int64_t wstride,
                   const double* c, int64_t owned, const int32_t* indptr, const int32_t* indices, double* values,
                   const int32_t* ghost_column, const int32_t* indptr_o, const int32_t* indices_o,
                   double* values_o, const uint8_t* constrained, int64_t bs, double* ghost,
-                  const int64_t* ghost_slot, double* Ae, double* X, int64_t* place)
+                  const int64_t* ghost_slot, double* Ae, double* X, int64_t* place, int32_t* map)
 {
   tabulate_t kernel = (tabulate_t)address;
   const int64_t n = nb * bs;
@@ -111,9 +118,18 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
         const int32_t* ix = off ? indices_o : indices;
         const int64_t col0 = off ? (int64_t)ghost_column[nodes[j] - owned] : (int64_t)nodes[j] * bs;
         const int64_t start = ip[row0], stop = ip[row0 + 1];
+        int32_t* known = map == NULL ? NULL : map + (k * nb + i) * nb + j;
+        if (known != NULL && *known >= 0 && start + *known + bs <= stop && ix[start + *known] == col0
+            && ix[start + *known + bs - 1] == col0 + bs - 1)
+        {
+          place[j] = *known; /* where the last call found it, still there */
+          continue;
+        }
         const int64_t p = col0 < 0 ? -1 : find(ix, start, stop, col0);
         const int whole = p >= 0 && p + bs <= stop && ix[p + bs - 1] == col0 + bs - 1;
         place[j] = whole ? p - start : -1;
+        if (known != NULL)
+          *known = (int32_t)place[j];
         missing += !whole;
       }
       for (int64_t a = 0; a < bs; ++a)
@@ -311,7 +327,7 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
                   const double* c, int64_t owned, const int32_t* indptr, const int32_t* indices, double* values,
                   const int32_t* ghost_column, const int32_t* indptr_o, const int32_t* indices_o,
                   double* values_o, const uint8_t* constrained, int64_t bs, double* ghost,
-                  const int64_t* ghost_slot, double* Ae, double* X, int64_t* place);
+                  const int64_t* ghost_slot, double* Ae, double* X, int64_t* place, int32_t* map);
 int64_t set_constrained_diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices,
                                  const uint8_t* constrained, double* values);
 int64_t upper_blocks(int64_t nblocks, int64_t bs, const int32_t* indptr, const int32_t* indices,
@@ -423,6 +439,7 @@ class CellAssembler:
         # their rows and columns for MatSetValuesBlockedLocal: the rows of owned nodes left out (−1)
         self._ghost_columns = self.blocks[self.ghost_cells]
         self._ghost_rows = np.where(self._ghost_columns < self.owned, -1, self._ghost_columns).astype(np.int32)
+        self.maps = None  # per integral: where each pair of a cell's nodes has its block in the rows
 
     def ghost_columns(self, colmap: np.ndarray) -> np.ndarray:
         """Each ghost node's first column in the off-diagonal block whose columns are the global
@@ -469,7 +486,9 @@ class CellAssembler:
         else:
             off_args = (null, null, null, null)
         missing = 0
-        for (address, cells, key), slot in zip(self.integrals, self.slots):
+        if self.maps is None:  # the places of the nodal blocks in their rows, found by the first call
+            self.maps = [np.full((len(cells), nb * nb), -1, dtype=np.int32) for _, cells, _ in self.integrals]
+        for (address, cells, key), slot, known in zip(self.integrals, self.slots, self.maps):
             w = np.ascontiguousarray(packed[key], dtype=np.float64)
             if w.size == 0:
                 w = np.zeros((len(cells), 1))
@@ -479,7 +498,8 @@ class CellAssembler:
                                      ptr("int32_t", indptr), ptr("int32_t", indices), ptr("double", values), *off_args,
                                      ptr("uint8_t", held), self.bs, ptr("double", ghost) if ghost.size else null,
                                      ptr("int64_t", slot) if len(self.ghost_cells) else null,
-                                     ptr("double", Ae), ptr("double", X), ptr("int64_t", place))
+                                     ptr("double", Ae), ptr("double", X), ptr("int64_t", place),
+                                     ptr("int32_t", known))
         missing += lib.set_constrained_diagonal(len(indptr) - 1, ptr("int32_t", indptr), ptr("int32_t", indices),
                                                 ptr("uint8_t", held), ptr("double", values))
         if missing:

@@ -178,6 +178,17 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
   return missing;
 }
 
+/* out[row] = the diagonal entry of each row (0 where the pattern lacks it), found by bisection in
+   the row's sorted columns (PETSc's MatGetDiagonal scans each row from its start) */
+void diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, const double* values, double* out)
+{
+  for (int64_t row = 0; row < nrows; ++row)
+  {
+    const int64_t p = find(indices, indptr[row], indptr[row + 1], row);
+    out[row] = p < 0 ? 0.0 : values[p];
+  }
+}
+
 int64_t set_constrained_diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices,
                                  const uint8_t* constrained, double* values)
 {
@@ -330,6 +341,7 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
                   const int64_t* ghost_slot, double* Ae, double* X, int64_t* place, int32_t* map);
 int64_t set_constrained_diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices,
                                  const uint8_t* constrained, double* values);
+void diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, const double* values, double* out);
 int64_t upper_blocks(int64_t nblocks, int64_t bs, const int32_t* indptr, const int32_t* indices,
                      const double* values, const int32_t* bi, const int32_t* bj, double* out);
 void patch_moments(int64_t ncells, int64_t k, const int32_t* cells, int64_t d, const double* a,
@@ -507,6 +519,18 @@ class CellAssembler:
         if off is None:
             return None
         return self._ghost_rows, self._ghost_columns, ghost
+
+
+def diagonal(indptr, indices, values) -> np.ndarray:
+    """The diagonal entries of the CSR rows (indptr, indices, values) (0 where a row lacks one):
+    those of an AIJ matrix, or of the owned block of an MPIAIJ one (local columns)."""
+    module = compiled()
+    ffi, lib = module.ffi, module.lib
+    out = np.empty(len(indptr) - 1)
+    if len(out):
+        lib.diagonal(len(out), ffi.cast("int32_t*", indptr.ctypes.data), ffi.cast("int32_t*", indices.ctypes.data),
+                     ffi.cast("double*", values.ctypes.data), ffi.cast("double*", out.ctypes.data))
+    return out
 
 
 def upper_blocks(indptr, indices, values, bs: int, bi, bj, out) -> None:

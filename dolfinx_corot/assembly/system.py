@@ -390,13 +390,27 @@ class System:
         force computed from coordinates of size c_i carries errors of about ε K_ii c_i on dof i
         (ε K_ii on a rotation, angles of order one), so no residual below
         ε ‖diag(K) c‖ can be told from zero."""
-        if self._diagonal is None:
-            self._diagonal = self.A.createVecLeft()
-        self.A.getDiagonal(self._diagonal)
-        dc = self._diagonal.array_r * self._coordinates  # (rotations: coordinate 1)
+        dc = self._tangent_diagonal() * self._coordinates  # (rotations: coordinate 1)
         dc *= dc
         sq = self._reduce(dc @ self._membership, MPI.SUM)
         self.floors = {"force": _EPS * math.sqrt(sq[0]), "moment": _EPS * math.sqrt(sq[1])}
+
+    def _tangent_diagonal(self) -> np.ndarray:
+        """The owned diagonal of A: read by the compiled loop where it assembles A (bisection in
+        each row; PETSc's MatGetDiagonal scans rows from their start, 14 ms on the 116 k-dof
+        block against 1 ms), else PETSc's."""
+        if self._cells is not None and self.A.getType() in ("seqaij", "mpiaij"):
+            from . import cells
+
+            if self.comm.size == 1:
+                with petsc.SeqAIJArrays(self.A, write=False) as (indptr, indices, values):
+                    return cells.diagonal(indptr, indices, values)
+            with petsc.MPIAIJArrays(self.A, write=False) as ((indptr, indices, values), _, _):
+                return cells.diagonal(indptr, indices, values)
+        if self._diagonal is None:
+            self._diagonal = self.A.createVecLeft()
+        self.A.getDiagonal(self._diagonal)
+        return self._diagonal.array_r
 
     def correction_norms(self) -> dict[str, tuple[float, float]]:
         """Per field: (‖dx‖, ‖Σ corrections of the step‖) — translations, rotations."""

@@ -95,6 +95,8 @@ class System:
     symmetric part where its skew part vanishes at equilibrium; see :meth:`symmetrize`).
     """
 
+    _cells = None  # the compiled assembly of the parts' tangent (assembly.cells), where it serves
+
     def __init__(self, model: Model, options_prefix: str = "dc_newton_", symmetric: bool | None = None,
                  solver: str = "direct", contributions: Sequence[Contribution] = (), tangent: str = "auto"):
         validate.choice("System", "tangent", tangent, validate.TANGENTS)

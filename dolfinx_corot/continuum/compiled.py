@@ -23,9 +23,9 @@ the last term being the geometric stiffness. The strains are formed from H = ∇
 E = (H + Hᵀ + HᵀH)/2 and J − 1 from the invariants of H (ln J = log1p(J − 1)), not as FᵀF − I
 and det F − 1: those differences of numbers near 1 keep about 7 of the 16 digits of a strain of
 1e-9 (FFCx's kernels of the UFL forms are off by 8e-8 there; these by 2e-15). The block is
-symmetric in (a, i) ↔ (b, j): only
-the blocks b ≥ a are computed, at every point at once (the points are the inner index, so that
-the compiler vectorizes the sums), and mirrored. The residual is ∫ F S g_a dX. Both are the
+symmetric in (a, i) ↔ (b, j): only the blocks b ≥ a are computed, at four points at once (the
+points are the inner index, held in vectors of four doubles; the rule is padded with points of
+weight 0), and mirrored. The residual is ∫ F S g_a dX. Both are the
 UFL forms' integrals with the same quadrature (FFCx's default rule of the same degree) and
 the same tabulated shape functions (basix), to rounding; in 2D (plane strain) F, S, E are
 2 × 2 as in :mod:`.laws`.
@@ -392,7 +392,7 @@ def kernels(law: type, cell: str, degree: int, geometry_degree: int, quadrature_
     module = _MODULES.get(key)
     if module is None:
         text = source(*key)
-        try:  # the points' vectors in the processor's widest registers
+        try:  # code for this processor's vector instructions
             module = _cells.build("_dc_hyperelastic_", text, _CDEF, ("-O3", "-march=native", "-Wno-psabi", "-g0"))
         except Exception:  # a compiler without -march=native
             module = _cells.build("_dc_hyperelastic_", text, _CDEF, ("-O3", "-g0"))

@@ -33,52 +33,29 @@ from pathlib import Path
 
 import numpy as np
 
+import block_mesh
+from block_mesh import E, NU
+
 OUT = Path(__file__).resolve().parent.parent / "output" / "block_calculix"
-L, E, NU, LOAD = 10.0, 1e5, 0.3, 75.0
 
 
 def write_input(path: Path, n: tuple[int, int, int], solver: str) -> int:
     """The input deck; returns the tip node's number (0 if the end face has no centre node)."""
-    nx, ny, nz = n
-    x = np.linspace(0.0, L, nx + 1)
-    y = np.linspace(0.0, 1.0, ny + 1)
-    z = np.linspace(0.0, 1.0, nz + 1)
-
-    def node(i, j, k):
-        return 1 + i + (nx + 1) * (j + (ny + 1) * k)
-
     lines = ["*HEADING", "SVK cantilever block (dolfinx_corot benchmarks/block_calculix.py)", "*NODE"]
-    K, J, I = np.meshgrid(np.arange(nz + 1), np.arange(ny + 1), np.arange(nx + 1), indexing="ij")
-    ids = node(I, J, K).ravel()
-    coords = np.column_stack([x[I.ravel()], y[J.ravel()], z[K.ravel()]])
-    lines += [f"{i},{a:.12g},{b:.12g},{c:.12g}" for i, (a, b, c) in zip(ids, coords)]
+    lines += [f"{i},{x:.12g},{y:.12g},{z:.12g}" for i, x, y, z in block_mesh.coordinates(n)]
     lines.append("*ELEMENT, TYPE=C3D8, ELSET=EALL")
-    e = 1
-    for k in range(nz):
-        for j in range(ny):
-            for i in range(nx):
-                c = [node(i, j, k), node(i + 1, j, k), node(i + 1, j + 1, k), node(i, j + 1, k),
-                     node(i, j, k + 1), node(i + 1, j, k + 1), node(i + 1, j + 1, k + 1), node(i, j + 1, k + 1)]
-                lines.append(f"{e}," + ",".join(map(str, c)))
-                e += 1
+    lines += [f"{e}," + ",".join(map(str, c)) for e, c in enumerate(block_mesh.hexahedra(n), start=1)]
     lines.append("*NSET, NSET=FIXED")
-    fixed = [node(0, j, k) for k in range(nz + 1) for j in range(ny + 1)]
+    fixed = block_mesh.clamped(n)
     lines += [",".join(map(str, fixed[i:i + 16])) for i in range(0, len(fixed), 16)]
-    tip = node(nx, ny // 2, nz // 2) if ny % 2 == 0 and nz % 2 == 0 else 0
+    tip = block_mesh.tip(n)
     lines += ["*NSET, NSET=TIP", str(tip)] if tip else []
     lines += ["*BOUNDARY", "FIXED,1,3", "*MATERIAL, NAME=SVK", "*ELASTIC", f"{E:g},{NU:g}",
               "*SOLID SECTION, ELSET=EALL, MATERIAL=SVK",
               "*STEP, NLGEOM, INC=1000",
               f"*STATIC, DIRECT, SOLVER={'ITERATIVE CHOLESKY' if solver == 'iterative' else 'SPOOLES'}",
               "0.2, 1.0", "*CLOAD"]
-    # nodal forces of a uniform traction on a bilinear face grid: the tributary areas
-    wy = np.full(ny + 1, 1.0 / ny)
-    wy[[0, -1]] *= 0.5
-    wz = np.full(nz + 1, 1.0 / nz)
-    wz[[0, -1]] *= 0.5
-    for k in range(nz + 1):
-        for j in range(ny + 1):
-            lines.append(f"{node(nx, j, k)},2,{-LOAD * wy[j] * wz[k]:.15g}")
+    lines += [f"{i},2,{f:.15g}" for i, f in block_mesh.end_loads(n)]
     if tip:
         lines += ["*NODE PRINT, NSET=TIP", "U"]
     lines += ["*END STEP", ""]

@@ -13,23 +13,27 @@ overrides them: e.g. ``'{"smoother_type": "spai0", "krylov_type": "cg"}'``), Kra
 solver for solids, or Kratos's sparse LU (``--solver direct``).
 Convergence: the residual norm below 1e-9 of the step's first (relative) or 1e-12 (absolute).
 
-Writes output/block_kratos/block_<mesh>_<solver>.json and prints it: the wall time of the
-analysis (set-up included, one thread), its peak resident memory, Newton iterations and the
-displacement of the node at the end face's centre (needs even n_y and n_z).
+Writes output/block_kratos/block_<mesh>_<solver>.{json, csv, png} and prints the JSON: the wall
+time of the analysis (set-up included, one thread), its peak resident memory, Newton iterations
+and the displacement of the node at the end face's centre (needs even n_y and n_z); the CSV and
+the PNG are the steps' Newton iterations and times. The mesh is ``block_mesh.py``'s, as CalculiX's.
 
 Needs Kratos in the Python that runs it (not a dependency of this project), e.g. in a venv of its
 own: ``pip install KratosMultiphysics KratosStructuralMechanicsApplication
-KratosLinearSolversApplication``, then ``OMP_NUM_THREADS=1 python benchmarks/block_kratos.py``.
+KratosLinearSolversApplication matplotlib``, then ``OMP_NUM_THREADS=1 python benchmarks/block_kratos.py``.
 """
 import argparse
+import csv
 import json
 import os
 import resource
 import time
 from pathlib import Path
 
+import block_mesh
+from block_mesh import E, NU, STEPS
+
 OUT = Path(__file__).resolve().parent.parent / "output" / "block_kratos"
-L, E, NU, LOAD, STEPS = 10.0, 1e5, 0.3, 75.0, 5
 
 
 def main() -> None:
@@ -46,51 +50,31 @@ def main() -> None:
     from KratosMultiphysics import python_linear_solver_factory
 
     KM.Logger.GetDefaultOutput().SetSeverity(KM.Logger.Severity.WARNING)
-    nx, ny, nz = args.mesh
+    n = tuple(args.mesh)
     model = KM.Model()
     mp = model.CreateModelPart("block")
     mp.SetBufferSize(2)
     mp.ProcessInfo[KM.DOMAIN_SIZE] = 3
     for var in (KM.DISPLACEMENT, KM.REACTION, SMA.POINT_LOAD, KM.VOLUME_ACCELERATION):
         mp.AddNodalSolutionStepVariable(var)
-
-    def node(i, j, k):
-        return 1 + i + (nx + 1) * (j + (ny + 1) * k)
-
-    for k in range(nz + 1):
-        for j in range(ny + 1):
-            for i in range(nx + 1):
-                mp.CreateNewNode(node(i, j, k), L * i / nx, j / ny, k / nz)
+    for i, x, y, z in block_mesh.coordinates(n):
+        mp.CreateNewNode(i, x, y, z)
     props = mp.GetProperties()[1]
     props.SetValue(KM.YOUNG_MODULUS, E)
     props.SetValue(KM.POISSON_RATIO, NU)
     props.SetValue(KM.DENSITY, 1.0)
     props.SetValue(KM.CONSTITUTIVE_LAW, SMA.LinearElastic3DLaw())
-    e = 1
-    for k in range(nz):
-        for j in range(ny):
-            for i in range(nx):
-                c = [node(i, j, k), node(i + 1, j, k), node(i + 1, j + 1, k), node(i, j + 1, k),
-                     node(i, j, k + 1), node(i + 1, j, k + 1), node(i + 1, j + 1, k + 1), node(i, j + 1, k + 1)]
-                mp.CreateNewElement("TotalLagrangianElement3D8N", e, c, props)
-                e += 1
+    for e, c in enumerate(block_mesh.hexahedra(n), start=1):
+        mp.CreateNewElement("TotalLagrangianElement3D8N", e, c, props)
     for comp in "XYZ":
         KM.VariableUtils().AddDof(getattr(KM, f"DISPLACEMENT_{comp}"), getattr(KM, f"REACTION_{comp}"), mp)
-    for k in range(nz + 1):
-        for j in range(ny + 1):
-            n = mp.GetNode(node(0, j, k))
-            for comp in "XYZ":
-                n.Fix(getattr(KM, f"DISPLACEMENT_{comp}"))
-    # nodal forces of a uniform traction on the bilinear end face: the tributary areas
+    for i in block_mesh.clamped(n):
+        for comp in "XYZ":
+            mp.GetNode(i).Fix(getattr(KM, f"DISPLACEMENT_{comp}"))
     loads = []
-    c = 1
-    for k in range(nz + 1):
-        for j in range(ny + 1):
-            w = (0.5 if j in (0, ny) else 1.0) / ny * (0.5 if k in (0, nz) else 1.0) / nz
-            nid = node(nx, j, k)
-            mp.CreateNewCondition("PointLoadCondition3D1N", c, [nid], props)
-            loads.append((mp.GetNode(nid), -LOAD * w))
-            c += 1
+    for c, (i, f) in enumerate(block_mesh.end_loads(n), start=1):
+        mp.CreateNewCondition("PointLoadCondition3D1N", c, [i], props)
+        loads.append((mp.GetNode(i), f))
     if args.solver == "iterative":
         settings = {"solver_type": "amgcl", "verbosity": 0, **json.loads(args.amgcl)}
     else:
@@ -102,35 +86,59 @@ def main() -> None:
     strategy = KM.ResidualBasedNewtonRaphsonStrategy(mp, scheme, criterion, builder, 30, True, False, True)
     strategy.SetEchoLevel(0)
     strategy.Initialize()
-    iterations = []
+    history = []  # (step, load factor, Newton iterations, wall time of the step)
     for step in range(1, STEPS + 1):
+        t = time.perf_counter()
         lam = step / STEPS
         mp.CloneTimeStep(lam)
         mp.ProcessInfo[KM.STEP] = step
-        for n, f in loads:
-            n.SetSolutionStepValue(SMA.POINT_LOAD, [0.0, lam * f, 0.0])
+        for node, f in loads:
+            node.SetSolutionStepValue(SMA.POINT_LOAD, [0.0, lam * f, 0.0])
         strategy.InitializeSolutionStep()
         strategy.Predict()
         converged = strategy.SolveSolutionStep()
         strategy.FinalizeSolutionStep()
-        iterations.append(mp.ProcessInfo[KM.NL_ITERATION_NUMBER])
+        history.append((step, lam, mp.ProcessInfo[KM.NL_ITERATION_NUMBER], time.perf_counter() - t))
         if not converged:
             raise SystemExit(f"Kratos: step {step} did not converge")
     wall = time.perf_counter() - t0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     tip = None
-    if ny % 2 == 0 and nz % 2 == 0:
-        u = mp.GetNode(node(nx, ny // 2, nz // 2)).GetSolutionStepValue(KM.DISPLACEMENT)
+    if block_mesh.tip(n):
+        u = mp.GetNode(block_mesh.tip(n)).GetSolutionStepValue(KM.DISPLACEMENT)
         tip = [u[0], u[1], u[2]]
     data = {"peer": "Kratos", "version": KM.KratosGlobals.Kernel.Version() if hasattr(KM.KratosGlobals, "Kernel")
-            else "", "mesh": args.mesh, "solver": args.solver, "dofs": 3 * (nx + 1) * (ny + 1) * (nz + 1),
-            "linear_solver": settings, "wall_s": wall, "peak_rss_MB": peak, "newton_iterations": sum(iterations),
-            "iterations_per_step": iterations, "tip_displacement": tip}
+            else "", "mesh": args.mesh, "solver": args.solver, "dofs": 3 * (n[0] + 1) * (n[1] + 1) * (n[2] + 1),
+            "linear_solver": settings, "wall_s": wall, "peak_rss_MB": peak,
+            "newton_iterations": sum(h[2] for h in history), "iterations_per_step": [h[2] for h in history],
+            "tip_displacement": tip}
     OUT.mkdir(parents=True, exist_ok=True)
     stem = OUT / f"block_{'x'.join(map(str, args.mesh))}_{args.solver}"
     stem.with_suffix(".json").write_text(json.dumps(data, indent=1))
+    with open(stem.with_suffix(".csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["step", "load_factor", "newton_iterations", "wall_time_s"])
+        w.writerows(history)
+    _plot(history, data, stem.with_suffix(".png"))
     print(json.dumps(data, indent=1))
 
+
+def _plot(history: list, data: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    ax.bar([h[0] for h in history], [h[3] for h in history], color="tab:blue")
+    for h in history:
+        ax.annotate(f"{h[2]} it.", (h[0], h[3]), ha="center", va="bottom", fontsize=8)
+    ax.set_xlabel("load step")
+    ax.set_ylabel("wall time of the step (s)")
+    ax.set_title(f"Kratos, {data['dofs']} dofs: {data['wall_s']:.1f} s, {data['peak_rss_MB']:.0f} MB")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 if __name__ == "__main__":
     main()

@@ -64,6 +64,38 @@ static const vd DG[D][NG][NC] = @DG@;
 
 #define HSUM(v) (((v)[0] + (v)[2]) + ((v)[1] + (v)[3]))
 
+/* det A (the cofactor expansion) */
+static inline vd determinant(vd A[D][D])
+{
+#if D == 3
+  return A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0])
+       + A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]);
+#else
+  return A[0][0] * A[1][1] - A[0][1] * A[1][0];
+#endif
+}
+
+/* Ai = A^-1 by cofactors, given det A */
+static inline void inverse(vd A[D][D], vd det, vd Ai[D][D])
+{
+#if D == 3
+  Ai[0][0] = (A[1][1] * A[2][2] - A[1][2] * A[2][1]) / det;
+  Ai[0][1] = (A[0][2] * A[2][1] - A[0][1] * A[2][2]) / det;
+  Ai[0][2] = (A[0][1] * A[1][2] - A[0][2] * A[1][1]) / det;
+  Ai[1][0] = (A[1][2] * A[2][0] - A[1][0] * A[2][2]) / det;
+  Ai[1][1] = (A[0][0] * A[2][2] - A[0][2] * A[2][0]) / det;
+  Ai[1][2] = (A[0][2] * A[1][0] - A[0][0] * A[1][2]) / det;
+  Ai[2][0] = (A[1][0] * A[2][1] - A[1][1] * A[2][0]) / det;
+  Ai[2][1] = (A[0][1] * A[2][0] - A[0][0] * A[2][1]) / det;
+  Ai[2][2] = (A[0][0] * A[1][1] - A[0][1] * A[1][0]) / det;
+#else
+  Ai[0][0] = A[1][1] / det;
+  Ai[0][1] = -A[0][1] / det;
+  Ai[1][0] = -A[1][0] / det;
+  Ai[1][1] = A[0][0] / det;
+#endif
+}
+
 /* At every point: the weight times |det J| (wq), the reference gradients g[a][k], F, the
    law's 2nd Piola–Kirchhoff stress S, f[a][i], M[i][j] and mu~ (see the module's docstring).
    Returns 0, or 1 where J <= 0 (neo-Hookean: no stress there). */
@@ -85,26 +117,8 @@ static int points(const double* w, const double* X, vd wq[NC], vd g[NN][D][NC], 
           s += SPLAT(X[3 * n + i]) * DG[k][n][q];
         J[i][k] = s;
       }
-#if D == 3
-    const vd det = J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1])
-                 - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0])
-                 + J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
-    K[0][0] = (J[1][1] * J[2][2] - J[1][2] * J[2][1]) / det;
-    K[0][1] = (J[0][2] * J[2][1] - J[0][1] * J[2][2]) / det;
-    K[0][2] = (J[0][1] * J[1][2] - J[0][2] * J[1][1]) / det;
-    K[1][0] = (J[1][2] * J[2][0] - J[1][0] * J[2][2]) / det;
-    K[1][1] = (J[0][0] * J[2][2] - J[0][2] * J[2][0]) / det;
-    K[1][2] = (J[0][2] * J[1][0] - J[0][0] * J[1][2]) / det;
-    K[2][0] = (J[1][0] * J[2][1] - J[1][1] * J[2][0]) / det;
-    K[2][1] = (J[0][1] * J[2][0] - J[0][0] * J[2][1]) / det;
-    K[2][2] = (J[0][0] * J[1][1] - J[0][1] * J[1][0]) / det;
-#else
-    const vd det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
-    K[0][0] = J[1][1] / det;
-    K[0][1] = -J[0][1] / det;
-    K[1][0] = -J[1][0] / det;
-    K[1][1] = J[0][0] / det;
-#endif
+    const vd det = determinant(J);
+    inverse(J, det, K);
     for (int l = 0; l < 4; ++l)
       wq[q][l] = W[q][l] * fabs(det[l]);
     /* g_a = J^-T dN_a; H = grad u = sum_a u_a g_a^T, F = I + H. The strains are formed from H
@@ -143,28 +157,12 @@ static int points(const double* w, const double* X, vd wq[NC], vd g[NN][D][NC], 
 #if D == 3
     const vd Jm1 = H[0][0] + H[1][1] + H[2][2]
                  + (H[0][0] * H[1][1] - H[0][1] * H[1][0]) + (H[0][0] * H[2][2] - H[0][2] * H[2][0])
-                 + (H[1][1] * H[2][2] - H[1][2] * H[2][1])
-                 + H[0][0] * (H[1][1] * H[2][2] - H[1][2] * H[2][1])
-                 - H[0][1] * (H[1][0] * H[2][2] - H[1][2] * H[2][0])
-                 + H[0][2] * (H[1][0] * H[2][1] - H[1][1] * H[2][0]);
-    const vd Jd = SPLAT(1.0) + Jm1;
-    Fi[0][0] = (Fq[1][1] * Fq[2][2] - Fq[1][2] * Fq[2][1]) / Jd;
-    Fi[0][1] = (Fq[0][2] * Fq[2][1] - Fq[0][1] * Fq[2][2]) / Jd;
-    Fi[0][2] = (Fq[0][1] * Fq[1][2] - Fq[0][2] * Fq[1][1]) / Jd;
-    Fi[1][0] = (Fq[1][2] * Fq[2][0] - Fq[1][0] * Fq[2][2]) / Jd;
-    Fi[1][1] = (Fq[0][0] * Fq[2][2] - Fq[0][2] * Fq[2][0]) / Jd;
-    Fi[1][2] = (Fq[0][2] * Fq[1][0] - Fq[0][0] * Fq[1][2]) / Jd;
-    Fi[2][0] = (Fq[1][0] * Fq[2][1] - Fq[1][1] * Fq[2][0]) / Jd;
-    Fi[2][1] = (Fq[0][1] * Fq[2][0] - Fq[0][0] * Fq[2][1]) / Jd;
-    Fi[2][2] = (Fq[0][0] * Fq[1][1] - Fq[0][1] * Fq[1][0]) / Jd;
+                 + (H[1][1] * H[2][2] - H[1][2] * H[2][1]) + determinant(H);
 #else
-    const vd Jm1 = H[0][0] + H[1][1] + (H[0][0] * H[1][1] - H[0][1] * H[1][0]);
-    const vd Jd = SPLAT(1.0) + Jm1;
-    Fi[0][0] = Fq[1][1] / Jd;
-    Fi[0][1] = -Fq[0][1] / Jd;
-    Fi[1][0] = -Fq[1][0] / Jd;
-    Fi[1][1] = Fq[0][0] / Jd;
+    const vd Jm1 = H[0][0] + H[1][1] + determinant(H);
 #endif
+    const vd Jd = SPLAT(1.0) + Jm1;
+    inverse(Fq, Jd, Fi);
     for (int l = 0; l < 4; ++l)
     {
       bad |= !(Jd[l] > 0.0);
@@ -188,14 +186,10 @@ static int points(const double* w, const double* X, vd wq[NC], vd g[NN][D][NC], 
         M[i][j][q] = SPLAT(i == j ? 1.0 : 0.0);
       }
     mut[q] = SPLAT(mu) - SPLAT(lmbda) * lnJ;
-    for (int a = 0; a < NN; ++a)
-      for (int i = 0; i < D; ++i)
-      {
-        vd s = SPLAT(0.0);
-        for (int k = 0; k < D; ++k)
-          s += Fi[k][i] * g[a][k][q];
-        f[a][i][q] = s;
-      }
+    vd T[D][D]; /* f_a = T g_a */
+    for (int i = 0; i < D; ++i)
+      for (int k = 0; k < D; ++k)
+        T[i][k] = Fi[k][i];
 #else
     /* S = lambda tr(E) I + 2 mu E; f_a = F g_a; M = F F^T; mu~ = mu */
     vd trE = SPLAT(0.0);
@@ -211,15 +205,19 @@ static int points(const double* w, const double* X, vd wq[NC], vd g[NN][D][NC], 
         M[i][j][q] = s;
       }
     mut[q] = SPLAT(mu);
+    vd T[D][D]; /* f_a = T g_a */
+    for (int i = 0; i < D; ++i)
+      for (int k = 0; k < D; ++k)
+        T[i][k] = Fq[i][k];
+#endif
     for (int a = 0; a < NN; ++a)
       for (int i = 0; i < D; ++i)
       {
         vd s = SPLAT(0.0);
         for (int k = 0; k < D; ++k)
-          s += Fq[i][k] * g[a][k][q];
+          s += T[i][k] * g[a][k][q];
         f[a][i][q] = s;
       }
-#endif
   }
   return bad;
 }
@@ -395,7 +393,7 @@ def kernels(law: type, cell: str, degree: int, geometry_degree: int, quadrature_
         try:  # code for this processor's vector instructions
             module = _cells.build("_dc_hyperelastic_", text, _CDEF, ("-O3", "-march=native", "-Wno-psabi", "-g0"))
         except Exception:  # a compiler without -march=native
-            module = _cells.build("_dc_hyperelastic_", text, _CDEF, ("-O3", "-g0"))
+            module = _cells.build("_dc_hyperelastic_", text, _CDEF, ("-O3", "-Wno-psabi", "-g0"))
         _MODULES[key] = module
     ffi, lib = module.ffi, module.lib
     return (int(ffi.cast("uintptr_t", ffi.addressof(lib, "residual"))),

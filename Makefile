@@ -21,8 +21,14 @@ demo: setup
 demos: setup
 	@for d in demos/*.py; do echo "== $$d"; $(PY) $$d || exit 1; done
 
+# the serial tests on both cores (pytest-xdist), then the two-rank runs one at a time (they take
+# both cores each); the demos' serial values, which the two-rank runs must reproduce, pass from the
+# first run to the second through output/tests/serial
+SERIAL_OUTPUTS := $(CURDIR)/output/tests/serial
 test: setup
-	$(PY) -m pytest -ra --durations=25 tests
+	rm -rf $(SERIAL_OUTPUTS)
+	DC_SERIAL_OUTPUTS=$(SERIAL_OUTPUTS) $(PY) -m pytest -ra --durations=25 -n 2 --dist worksteal -m "not mpi" tests
+	DC_SERIAL_OUTPUTS=$(SERIAL_OUTPUTS) $(PY) -m pytest -ra --durations=25 -m mpi tests
 
 # the site: demo pages from demos/*.py and their outputs (shortened runs, reused while fresh)
 docs: setup-docs

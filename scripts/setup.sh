@@ -7,7 +7,7 @@
 #  2. .venv made by Debian's /usr/bin/python3 with --system-site-packages, so
 #     that it sees dolfinx; numpy & friends are pinned to Debian's versions by
 #     a constraints file that every pip call in the venv obeys (.venv/pip.conf).
-#  3. The package itself (editable) with numba, pyvista, tqdm, pytest, hypothesis.
+#  3. The package itself (editable) with numba, pyvista, tqdm, pytest, pytest-xdist, hypothesis.
 #  4. With the argument "docs": what the documentation site needs besides (Sphinx, MyST, MathJax,
 #     Chromium and its driver with selenium for `make docs-check`; furo, jupytext, nbclient and
 #     ipykernel from PyPI).
@@ -23,7 +23,7 @@ stamp="$venv/.dolfinx_corot-setup"
 debs=(python3-dolfinx-real python3-gmsh python3-meshio python3-venv python3-h5py
       python3-matplotlib python3-scipy python3-dev libopenblas0-pthread
       python3-pandas libegl1 libegl-mesa0 openmpi-bin)
-pip_pkgs=(numba pyvista tqdm pytest hypothesis)
+pip_pkgs=(numba pyvista tqdm pytest pytest-xdist hypothesis)
 docs_debs=(python3-sphinx python3-myst-parser libjs-mathjax chromium chromium-driver python3-selenium)
 docs_pip=("furo==2022.12.7" "markdown-it-py<3" jupytext nbclient ipykernel)  # myst-parser 0.18 needs markdown-it-py 2
 

@@ -46,7 +46,7 @@ def _run_script(tmp_path, mpi: bool) -> subprocess.CompletedProcess:
 
 
 @serial
-@pytest.mark.parametrize("mpi", [False, True], ids=["serial", "two ranks"])
+@pytest.mark.parametrize("mpi", [False, pytest.param(True, marks=pytest.mark.mpi)], ids=["serial", "two ranks"])
 def test_the_readme_first_script_shows_its_progress_and_nothing_on_stderr(tmp_path, mpi):
     """A fresh FFCx cache: the elements are compiled (setuptools' build lines went to stderr before);
     the 40 steps are reported once (rank 0), one line each, then the totals."""

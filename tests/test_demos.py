@@ -62,6 +62,12 @@ def _run_in_process(demo, outdir, monkeypatch):
 
 @pytest.fixture(scope="module")
 def serial_outputs(tmp_path_factory):
+    """Where the serial runs write and the two-rank runs read: ``DC_SERIAL_OUTPUTS`` where the
+    two kinds run in separate pytest sessions (``make test``), else a directory of this session."""
+    folder = os.environ.get("DC_SERIAL_OUTPUTS")
+    if folder:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        return Path(folder)
     return tmp_path_factory.mktemp("serial")
 
 

@@ -543,6 +543,34 @@ def test_patch_rotations_recover_a_rigid_rotation_of_the_mesh(compiled, monkeypa
     assert np.abs(R2 - Q).max() < 1e-13
 
 
+def test_the_compiled_polar_iteration_is_the_svd_rotation_where_it_answers():
+    """cells.polar3 (Newton's polar iteration) against the SVD's nearest proper rotation U Vᵀ on
+    patch moments near and far from a rotation, of any scale: the same rotation to 1e-13 wherever
+    det H > 0, and no answer (the SVD's turn then) where H reflects or is singular."""
+    from dolfinx_corot.assembly import amg, cells
+
+    module = cells.compiled()
+    rng = np.random.default_rng(3)
+    H = np.eye(3) + 0.3 * rng.normal(size=(2000, 3, 3))
+    H[:200] = rng.normal(size=(200, 3, 3))  # far from a rotation: about half reflect
+    H[200] = 0.0
+    H[201] = np.diag([1.0, 1.0, 0.0])
+    H[202] = np.diag([1.0, 1.0, -1e-3])
+    H *= np.exp(rng.uniform(-8.0, 8.0, size=(len(H), 1, 1)))
+    R = np.empty_like(H)
+    ok = np.zeros(len(H), dtype=np.uint8)
+    module.lib.polar3(len(H), amg._ptr(module, "double", H), amg._ptr(module, "double", R),
+                      amg._ptr(module, "uint8_t", ok))
+    det = np.linalg.det(H)
+    assert np.array_equal(ok == 1, det > 1e-13 * np.linalg.norm(H, axis=(1, 2)) ** 3)
+    assert 50 < np.sum(ok[:200] == 0) < 150 and not ok[200:203].any()
+    # round-off grows with the condition number of H: measured where it is below 100
+    s = np.linalg.svd(H, compute_uv=False)
+    fair = (ok == 1) & (s[:, 0] < 100.0 * s[:, 2])
+    assert fair.sum() > 1800
+    assert np.abs(R[fair] - amg._nearest_rotations(H[fair])).max() < 1e-13
+
+
 @pytest.mark.parametrize("compiled, d", [(True, 3), (False, 3), (True, 2)], ids=["compiled", "numpy", "plane"])
 def test_the_corotated_prolongator_is_the_built_one_turned_node_by_node(compiled, d, monkeypatch):
     """The finest prolongator of the block's GAMG hierarchy (3D, and plane strain), turned by a

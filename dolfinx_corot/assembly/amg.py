@@ -57,8 +57,9 @@ def patch_rotations(cells: np.ndarray, before: np.ndarray, after: np.ndarray, n:
     """The rotation of each of the first ``n`` nodes' patches from positions ``before`` to
     ``after`` ((nodes, d) each, every node the cells name): R_i (n, d, d), the rotation that
     minimizes Σ_c Σ_j |(x_j − x̄_c) − R (x⁰_j − x̄⁰_c)|² over the cells c around node i (x̄_c: the
-    mean of cell c's nodes), the polar factor of H_i = Σ_c Σ_j (x_j − x̄_c)(x⁰_j − x̄⁰_c)ᵀ. A node
-    without cells gets the identity. cells: (cells, nodes per cell) node indices."""
+    mean of cell c's nodes), the polar factor of H_i = Σ_c Σ_j (x_j − x̄_c)(x⁰_j − x̄⁰_c)ᵀ (in 3D by
+    Newton's polar iteration where det H_i > 0, compiled, else from the SVD; in the plane the
+    angle in closed form). A node without cells gets the identity. cells: (cells, nodes per cell) node indices."""
     cells = np.ascontiguousarray(cells, dtype=np.int32)
     before = np.ascontiguousarray(before, dtype=np.float64)
     after = np.ascontiguousarray(after, dtype=np.float64)
@@ -80,11 +81,29 @@ def patch_rotations(cells: np.ndarray, before: np.ndarray, after: np.ndarray, n:
                 inside = c[:, k] < n
                 for p in range(d * d):
                     H.reshape(n, d * d)[:, p] += np.bincount(c[inside, k], weights=M[inside, p], minlength=n)[:n]
+    if d == 2:  # the turn θ that maximizes tr(RᵀH): tan θ = (H₁₀ − H₀₁) / (H₀₀ + H₁₁)
+        theta = np.arctan2(H[:, 1, 0] - H[:, 0, 1], H[:, 0, 0] + H[:, 1, 1])
+        c, s = np.cos(theta), np.sin(theta)
+        return np.stack([np.stack([c, -s], axis=1), np.stack([s, c], axis=1)], axis=1)
+    R = np.empty_like(H)
+    rest = np.arange(n)
+    if module is not None:  # Newton's polar iteration where det H > 0 (cells.polar3), the SVD elsewhere
+        ok = np.zeros(n, dtype=np.uint8)
+        module.lib.polar3(n, _ptr(module, "double", H), _ptr(module, "double", R), _ptr(module, "uint8_t", ok))
+        rest = np.flatnonzero(ok == 0)
+    if len(rest):
+        R[rest] = _nearest_rotations(H[rest])
+    return R
+
+
+def _nearest_rotations(H: np.ndarray) -> np.ndarray:
+    """The proper rotations R (m, 3, 3) that maximize tr(RᵀH) for each of H (m, 3, 3), from the
+    SVD H = U S Vᵀ: U Vᵀ, its last axis turned where U Vᵀ reflects; the identity where H = 0."""
     U, s, Vt = np.linalg.svd(H)
-    sign = np.sign(np.linalg.det(U @ Vt))  # a proper rotation: the last axis turned where UVᵀ reflects
+    sign = np.sign(np.linalg.det(U @ Vt))
     U[:, :, -1] *= np.where(sign == 0.0, 1.0, sign)[:, None]
     R = U @ Vt
-    R[s[:, 0] == 0.0] = np.eye(d)
+    R[s[:, 0] == 0.0] = np.eye(3)
     return R
 
 

@@ -25,8 +25,8 @@ The same library copies a symmetric AIJ matrix's upper triangle into an SBAIJ ma
 nodal blocks (:func:`upper_blocks`; the operator of the iterative solver,
 :class:`~dolfinx_corot.assembly.petsc.SymmetricBlockOperator`), and holds the loops of the
 co-rotated AMG hierarchy (:mod:`dolfinx_corot.assembly.amg`: the patches' moments
-``patch_moments``, the check ``unlike_rows`` and the rotation ``rotate_rows`` of a
-prolongator's nodal rows).
+``patch_moments``, their rotations ``polar3``, the check ``unlike_rows`` and the rotation
+``rotate_rows`` of a prolongator's nodal rows).
 
 Used by :class:`~dolfinx_corot.assembly.system.System` for FFCx forms whose integrals are all
 cell integrals over meshes of at least :data:`MIN_CELLS` cells (on every rank).
@@ -45,6 +45,7 @@ import numpy as np
 MIN_CELLS = 4000  # meshes with fewer cells (on some rank) keep DOLFINx's insertion
 
 _SOURCE = r"""
+#include <math.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -291,6 +292,74 @@ void patch_moments(int64_t ncells, int64_t k, const int32_t* cells, int64_t d, c
   }
 }
 
+/* The orthogonal polar factor R of each of n 3 x 3 matrices H (row-major), H = R S with S
+   symmetric positive definite, by Newton's iteration X <- (z X + X^{-T} / z) / 2 with Higham's
+   scaling z = (|X^{-1}|_F / |X|_F)^{1/2} (Higham 1986, "Computing the polar decomposition, with
+   applications"), unscaled once close. Where det H > 0 that factor is the proper rotation
+   nearest H, the U V^T of H's SVD. ok[i] = 1 where it converged with det H_i > 0; 0 elsewhere
+   (singular, reflecting or not converged: the caller takes the SVD there). */
+void polar3(int64_t n, const double* H, double* R, uint8_t* ok)
+{
+  for (int64_t i = 0; i < n; ++i)
+  {
+    const double* h = H + 9 * i;
+    double* x = R + 9 * i;
+    double det = h[0] * (h[4] * h[8] - h[5] * h[7]) - h[1] * (h[3] * h[8] - h[5] * h[6])
+                 + h[2] * (h[3] * h[7] - h[4] * h[6]);
+    double norm = 0.0;
+    for (int p = 0; p < 9; ++p)
+    {
+      x[p] = h[p];
+      norm += h[p] * h[p];
+    }
+    ok[i] = 0;
+    if (!(det > 1e-13 * norm * sqrt(norm)))  /* singular to round-off, reflecting, or NaN */
+      continue;
+    int scaled = 1, last = 0;
+    for (int it = 0; it < 40; ++it)
+    {
+      /* c: the cofactors of X, so that X^{-T} = c / det X */
+      double c[9];
+      c[0] = x[4] * x[8] - x[5] * x[7];
+      c[1] = x[5] * x[6] - x[3] * x[8];
+      c[2] = x[3] * x[7] - x[4] * x[6];
+      c[3] = x[2] * x[7] - x[1] * x[8];
+      c[4] = x[0] * x[8] - x[2] * x[6];
+      c[5] = x[1] * x[6] - x[0] * x[7];
+      c[6] = x[1] * x[5] - x[2] * x[4];
+      c[7] = x[2] * x[3] - x[0] * x[5];
+      c[8] = x[0] * x[4] - x[1] * x[3];
+      const double d = x[0] * c[0] + x[1] * c[1] + x[2] * c[2];
+      if (!(d > 0.0))
+        break;
+      double nx = 0.0, nc = 0.0;
+      for (int p = 0; p < 9; ++p)
+      {
+        c[p] /= d;
+        nx += x[p] * x[p];
+        nc += c[p] * c[p];
+      }
+      const double z = scaled ? sqrt(sqrt(nc / nx)) : 1.0;
+      double change = 0.0;
+      for (int p = 0; p < 9; ++p)
+      {
+        const double y = 0.5 * (z * x[p] + c[p] / z);
+        change += (y - x[p]) * (y - x[p]);
+        x[p] = y;
+      }
+      if (last)  /* one step past a change of 1e-10: converged to round-off (quadratically) */
+      {
+        ok[i] = 1;
+        break;
+      }
+      if (change < 1e-4)
+        scaled = 0;
+      if (!scaled && change < 1e-20)
+        last = 1;
+    }
+  }
+}
+
 /* The rows of each node (bs of them, node i: rows i*bs ... i*bs + bs - 1) that do not hold the
    same columns in the same order: their number. */
 int64_t unlike_rows(int64_t nodes, int64_t bs, const int32_t* indptr, const int32_t* indices)
@@ -346,6 +415,7 @@ int64_t upper_blocks(int64_t nblocks, int64_t bs, const int32_t* indptr, const i
                      const double* values, const int32_t* bi, const int32_t* bj, double* out);
 void patch_moments(int64_t ncells, int64_t k, const int32_t* cells, int64_t d, const double* a,
                    const double* b, int64_t n, double* H);
+void polar3(int64_t n, const double* H, double* R, uint8_t* ok);
 int64_t unlike_rows(int64_t nodes, int64_t bs, const int32_t* indptr, const int32_t* indices);
 void rotate_rows(int64_t nodes, int64_t bs, const int32_t* indptr, const double* base, const double* R,
                  double* values);

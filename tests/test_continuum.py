@@ -443,6 +443,107 @@ def test_cg_reads_the_tangent_s_upper_triangle_in_nodal_blocks(n, degree):
     system.destroy()
 
 
+@pytest.mark.parametrize("n, degree", [((6, 2, 2), 1), ((3, 1, 1), 2), ((6, 3), 2)],
+                         ids=["hex-Q1", "hex-Q2", "plane-Q2"])
+def test_the_tangent_assembled_into_its_upper_block_triangle_alone_is_the_copied_one(monkeypatch, n, degree):
+    """On one rank, with the compiled assembly and CG on the upper block triangle, a tangent goes
+    into the SBAIJ operator alone (``CellAssembler.assemble_upper``: the node pairs on or above the
+    diagonal). At a deformed state with supports of all components and of one, that operator is
+    PETSc's conversion of the AIJ tangent the compiled loop assembles, to the last bit, and so is
+    the diagonal the residual's round-off floor reads, which is written into A as well (the
+    smoothers of a kept AMG hierarchy read it there); A's other values are made from S only when
+    A is read (``System.A``), then the assembled AIJ tangent: its upper triangle to the last bit,
+    its lower one to round-off (the mirror image of the upper). On several ranks the AIJ tangent
+    is assembled as before."""
+    from dolfinx_corot.assembly import cells
+
+    monkeypatch.setattr(cells, "MIN_CELLS", 0)
+    if len(n) == 3:
+        sc = _deformed_block("hexahedron", degree, dc.SaintVenantKirchhoff(1e5, 0.3), n=n)
+    else:
+        sc = dc.Scene(linear_solver="iterative")
+        b = sc.add_solid(_rectangle(*n, True), material=dc.NeoHookean(E, 0.3), degree=degree)
+        sc.fix(b, "left")
+        sc.fix(b, "right", dofs=("uy",))
+        sc.load(b, "right", traction=(1.0, 0.0))
+    system = make_system(sc.model, solver="iterative")
+    system.jacobian()  # DOLFINx's: lays out the pattern
+    assert system._cells is not None
+    rng = np.random.default_rng(5)
+    _move_to(system, sc.model, 0.01 * rng.normal(size=sc.model.state.x.array.size))
+    system.residual(0.5)
+    system.jacobian()
+    op = system.linear.operator
+    if comm.size > 1:
+        assert system._upper_operator() is None and (op is None or not op.assembled)
+        system.destroy()
+        return
+    assert op.upper_newer and op.assembled
+    state = system._A.stateGet()
+    direct = op.S.convert("dense", PETSc.Mat()).getDenseArray().copy()
+    diagonal = system._tangent_diagonal().copy()
+    assert np.array_equal(diagonal, system._A.getDiagonal().array)  # A's diagonal follows (Jacobi smoothers)
+    assert system._A.stateGet() == state  # nothing else read or written
+    mirrored = system.A.getValuesCSR()  # A read: made from S
+    assert not op.upper_newer and system._A.stateGet() != state
+    mirrored = [a.copy() for a in mirrored]
+    system._upper_assembly = False
+    system.jacobian()  # the compiled loop into A, as on several ranks
+    assert not op.upper_newer
+    A = system.A
+    indptr, indices, values = A.getValuesCSR()
+    assert np.array_equal(indptr, mirrored[0]) and np.array_equal(indices, mirrored[1])
+    rows = np.repeat(np.arange(len(indptr) - 1), np.diff(indptr))
+    bs = A.getBlockSize()
+    upper = (indices // bs > rows // bs) | ((indices // bs == rows // bs) & (indices >= rows))
+    assert np.array_equal(mirrored[2][upper], values[upper])
+    assert np.allclose(mirrored[2], values, rtol=0.0, atol=1e-14 * np.abs(values).max())
+    A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    reference = A.convert("sbaij", PETSc.Mat())
+    assert np.array_equal(direct, reference.convert("dense", PETSc.Mat()).getDenseArray())
+    assert np.array_equal(diagonal, A.getDiagonal().array)
+    reference.destroy()
+    system.destroy()
+
+
+def test_the_newton_path_on_the_upper_block_triangle_alone_is_the_path_on_the_copied_one(monkeypatch):
+    """The bent cantilever block (12 × 2 × 2, two steps, CG + AMG kept and co-rotated) with its
+    tangents assembled into the upper block triangle alone (the default on one rank) and into the
+    AIJ matrix then copied (``-dc_newton_upper_assembly false``): the same path to the last bit
+    (tip, Newton and Krylov iterations: CG, its preconditioner's build and its kept smoothers see
+    the same numbers); the AIJ matrix is filled from the operator only where it is read: here for
+    the inertia of each converged step's tangent (a model this small has its critical points
+    tracked), and never in between."""
+    from dolfinx_corot.assembly import cells, petsc
+
+    monkeypatch.setattr(cells, "MIN_CELLS", 0)
+    tips, newton, krylov, syncs = {}, {}, {}, {}
+    op_class = petsc.SymmetricBlockOperator
+    original = op_class.sync
+    for name, value in (("upper", "true"), ("copied", "false")):
+        options = PETSc.Options()
+        options["dc_newton_upper_assembly"] = value
+        try:
+            sc = _cantilever_block()
+            system = make_system(sc.model, solver="iterative")
+        finally:
+            del options["dc_newton_upper_assembly"]
+        calls = []
+        monkeypatch.setattr(op_class, "sync", lambda self: (calls.append(self.upper_newer), original(self))[1])
+        res = dc.solve(sc, dc.LoadControl(steps=2, extrapolate=True), system=system)
+        monkeypatch.setattr(op_class, "sync", original)
+        assert system.linear.operator.assembled == (name == "upper" and comm.size == 1)
+        tips[name] = res.history.column("tip_uy")[-1]
+        newton[name] = res.totals["newton_iterations"]
+        krylov[name] = system.krylov_iterations
+        syncs[name] = sum(calls)  # the syncs that made A from S
+        system.destroy()
+    assert tips["upper"] == tips["copied"]
+    assert newton["upper"] == newton["copied"]
+    assert krylov["upper"] == krylov["copied"]
+    assert syncs["copied"] == 0 and syncs["upper"] == (2 if comm.size == 1 else 0)
+
+
 def test_the_newton_path_on_the_block_operator_is_the_path_on_the_aij_tangent():
     """The bent cantilever block with CG on the tangent's upper triangle in nodal blocks (the
     default) and with CG on the AIJ tangent (``-dc_newton_block_operator false``): the same tip

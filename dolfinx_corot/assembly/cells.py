@@ -23,7 +23,11 @@ them, so that the matrix is again DOLFINx's to the last bit.
 
 The same library copies a symmetric AIJ matrix's upper triangle into an SBAIJ matrix of its
 nodal blocks (:func:`upper_blocks`; the operator of the iterative solver,
-:class:`~dolfinx_corot.assembly.petsc.SymmetricBlockOperator`), and holds the loops of the
+:class:`~dolfinx_corot.assembly.petsc.SymmetricBlockOperator`). On one rank the tangent can go
+into that SBAIJ matrix alone (:meth:`CellAssembler.assemble_upper`: the node pairs of a cell on or
+above the diagonal, 36 of a hexahedron's 64 blocks, the same sums in the same order as the copy's),
+the AIJ matrix being made from it (:func:`aij_from_upper`, the mirror image) only where it is
+read: the AMG's set-up, a fallback LU, the stability checks. The library also holds the loops of the
 co-rotated AMG hierarchy (:mod:`dolfinx_corot.assembly.amg`: the patches' moments
 ``patch_moments``, their rotations ``polar3``, the check ``unlike_rows`` and the rotation
 ``rotate_rows`` of a prolongator's nodal rows).
@@ -179,6 +183,177 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
   return missing;
 }
 
+/* The element matrices of ``cells`` (one rank, every node owned) added into the values ``out`` of
+   an SBAIJ matrix of the upper nodal block pattern (bi, bj; column-major bs x bs blocks, the
+   diagonal block whole: its upper triangle and the mirror image of that), as
+   :c:func:`upper_blocks` would copy them from the AIJ matrix that :c:func:`add_cells` assembles,
+   to the last bit (the same sums in the same order): only the node pairs (i, j) of a cell with
+   nodes[i] <= nodes[j]. Rows and columns of constrained dofs are left out. map: for each cell and
+   pair of its nodes, the block's place in the node's block row (from the row's start; -1: not
+   known), kept from call to call and checked at each use. Returns the number of blocks the
+   pattern lacks. */
+int64_t add_cells_upper(uintptr_t address, int64_t ncells, const int32_t* cells, int64_t nb,
+                        const int32_t* blocks, int64_t ng, const int32_t* geometry, const double* x,
+                        const double* w, int64_t wstride, const double* c, const uint8_t* constrained,
+                        int64_t bs, const int32_t* bi, const int32_t* bj, double* out, double* Ae, double* X,
+                        int32_t* map)
+{
+  tabulate_t kernel = (tabulate_t)address;
+  const int64_t n = nb * bs, bb = bs * bs;
+  int64_t missing = 0;
+  for (int64_t k = 0; k < ncells; ++k)
+  {
+    const int64_t cell = cells[k];
+    const int32_t* nodes = blocks + cell * nb;
+    for (int64_t i = 0; i < ng; ++i)
+      for (int d = 0; d < 3; ++d)
+        X[3 * i + d] = x[3 * (int64_t)geometry[cell * ng + i] + d];
+    memset(Ae, 0, n * n * sizeof(double));
+    kernel(Ae, w + k * wstride, c, X, NULL, NULL);
+    int held = 0;
+    for (int64_t i = 0; i < n; ++i)
+      held |= constrained[nodes[i / bs] * bs + i % bs];
+    for (int64_t i = 0; i < nb; ++i)
+    {
+      const int64_t I = nodes[i], k0 = bi[I], k1 = bi[I + 1];
+      for (int64_t j = 0; j < nb; ++j)
+      {
+        const int64_t J = nodes[j];
+        if (J < I)
+          continue;
+        int32_t* known = map + (k * nb + i) * nb + j;
+        int64_t at = *known >= 0 && k0 + *known < k1 && bj[k0 + *known] == J ? k0 + *known : -1;
+        if (at < 0)
+        {
+          int64_t lo = k0, hi = k1;
+          while (lo < hi)
+          {
+            const int64_t mid = (lo + hi) / 2;
+            if (bj[mid] < J)
+              lo = mid + 1;
+            else
+              hi = mid;
+          }
+          if (lo == k1 || bj[lo] != J)
+          {
+            ++missing;
+            continue;
+          }
+          at = lo;
+          *known = (int32_t)(lo - k0);
+        }
+        double* block = out + at * bb;
+        for (int64_t a = 0; a < bs; ++a)
+        {
+          if (held && constrained[I * bs + a])
+            continue;
+          const double* e = Ae + (i * bs + a) * n + j * bs;
+          for (int64_t b = 0; b < bs; ++b)
+          {
+            if (held && constrained[J * bs + b])
+              continue;
+            if (J != I)
+              block[b * bs + a] += e[b];
+            else if (b >= a)
+            {
+              block[b * bs + a] += e[b];
+              if (b > a)
+                block[a * bs + b] += e[b];
+            }
+          }
+        }
+      }
+    }
+  }
+  return missing;
+}
+
+/* The diagonal of the constrained rows set to 1 in the SBAIJ values out (the diagonal block first
+   in each block row); returns the number of block rows that lack it. */
+int64_t set_constrained_upper(int64_t nblocks, int64_t bs, const int32_t* bi, const int32_t* bj,
+                              const uint8_t* constrained, double* out)
+{
+  int64_t missing = 0;
+  for (int64_t I = 0; I < nblocks; ++I)
+    for (int64_t a = 0; a < bs; ++a)
+      if (constrained[I * bs + a])
+      {
+        if (bi[I] == bi[I + 1] || bj[bi[I]] != I)
+        {
+          ++missing;
+          continue;
+        }
+        out[bi[I] * bs * bs + a * bs + a] = 1.0;
+      }
+  return missing;
+}
+
+/* The symmetric AIJ matrix (indptr, indices, values; every row's columns sorted) of the SBAIJ
+   values S (upper block pattern bi, bj; column-major blocks): each block at its place in its rows
+   and, off the diagonal, transposed in the rows of its column. Entries of the AIJ pattern outside
+   the blocks are zero. cursor: nblocks * bs work entries. Returns the number of entries the AIJ
+   pattern lacks. */
+int64_t aij_from_upper(int64_t nblocks, int64_t bs, const int32_t* bi, const int32_t* bj, const double* S,
+                       const int32_t* indptr, const int32_t* indices, double* values, int64_t* cursor)
+{
+  int64_t missing = 0;
+  const int64_t bb = bs * bs, nrows = nblocks * bs;
+  memset(values, 0, (size_t)indptr[nrows] * sizeof(double));
+  for (int64_t r = 0; r < nrows; ++r)
+    cursor[r] = indptr[r];
+  for (int64_t I = 0; I < nblocks; ++I)
+  {
+    for (int64_t k = bi[I]; k < bi[I + 1]; ++k)
+    {
+      const int64_t J = bj[k];
+      const double* block = S + k * bb;
+      for (int64_t a = 0; a < bs; ++a)
+      {
+        /* row I*bs + a: the block's row a at columns J*bs ... */
+        const int64_t row = I * bs + a;
+        int64_t p = cursor[row];
+        const int64_t stop = indptr[row + 1];
+        for (int64_t b = 0; b < bs; ++b)
+        {
+          const int64_t col = J * bs + b;
+          while (p < stop && indices[p] < col)
+            ++p;
+          if (p == stop || indices[p] != col)
+          {
+            ++missing;
+            continue;
+          }
+          values[p] = block[b * bs + a];
+        }
+        cursor[row] = p;
+      }
+      if (J == I)
+        continue;
+      for (int64_t b = 0; b < bs; ++b)
+      {
+        /* row J*bs + b: the block's column b at columns I*bs ... */
+        const int64_t row = J * bs + b;
+        int64_t p = cursor[row];
+        const int64_t stop = indptr[row + 1];
+        for (int64_t a = 0; a < bs; ++a)
+        {
+          const int64_t col = I * bs + a;
+          while (p < stop && indices[p] < col)
+            ++p;
+          if (p == stop || indices[p] != col)
+          {
+            ++missing;
+            continue;
+          }
+          values[p] = block[b * bs + a];
+        }
+        cursor[row] = p;
+      }
+    }
+  }
+  return missing;
+}
+
 /* out[row] = the diagonal entry of each row (0 where the pattern lacks it), found by bisection in
    the row's sorted columns (PETSc's MatGetDiagonal scans each row from its start) */
 void diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, const double* values, double* out)
@@ -188,6 +363,22 @@ void diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, cons
     const int64_t p = find(indices, indptr[row], indptr[row + 1], row);
     out[row] = p < 0 ? 0.0 : values[p];
   }
+}
+
+/* values' diagonal entries = diag (rows that lack one: counted) */
+int64_t set_diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, const double* diag,
+                     double* values)
+{
+  int64_t missing = 0;
+  for (int64_t row = 0; row < nrows; ++row)
+  {
+    const int64_t p = find(indices, indptr[row], indptr[row + 1], row);
+    if (p < 0)
+      ++missing;
+    else
+      values[p] = diag[row];
+  }
+  return missing;
 }
 
 int64_t set_constrained_diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices,
@@ -408,8 +599,19 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
                   const int32_t* ghost_column, const int32_t* indptr_o, const int32_t* indices_o,
                   double* values_o, const uint8_t* constrained, int64_t bs, double* ghost,
                   const int64_t* ghost_slot, double* Ae, double* X, int64_t* place, int32_t* map);
+int64_t add_cells_upper(uintptr_t address, int64_t ncells, const int32_t* cells, int64_t nb,
+                        const int32_t* blocks, int64_t ng, const int32_t* geometry, const double* x,
+                        const double* w, int64_t wstride, const double* c, const uint8_t* constrained,
+                        int64_t bs, const int32_t* bi, const int32_t* bj, double* out, double* Ae, double* X,
+                        int32_t* map);
+int64_t set_constrained_upper(int64_t nblocks, int64_t bs, const int32_t* bi, const int32_t* bj,
+                              const uint8_t* constrained, double* out);
+int64_t aij_from_upper(int64_t nblocks, int64_t bs, const int32_t* bi, const int32_t* bj, const double* S,
+                       const int32_t* indptr, const int32_t* indices, double* values, int64_t* cursor);
 int64_t set_constrained_diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices,
                                  const uint8_t* constrained, double* values);
+int64_t set_diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, const double* diag,
+                     double* values);
 void diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, const double* values, double* out);
 int64_t upper_blocks(int64_t nblocks, int64_t bs, const int32_t* indptr, const int32_t* indices,
                      const double* values, const int32_t* bi, const int32_t* bj, double* out);
@@ -522,6 +724,7 @@ class CellAssembler:
         self._ghost_columns = self.blocks[self.ghost_cells]
         self._ghost_rows = np.where(self._ghost_columns < self.owned, -1, self._ghost_columns).astype(np.int32)
         self.maps = None  # per integral: where each pair of a cell's nodes has its block in the rows
+        self.upper_maps = None  # the same in the block rows of the upper triangle (assemble_upper)
 
     def ghost_columns(self, colmap: np.ndarray) -> np.ndarray:
         """Each ghost node's first column in the off-diagonal block whose columns are the global
@@ -591,6 +794,65 @@ class CellAssembler:
         return self._ghost_rows, self._ghost_columns, ghost
 
 
+    def assemble_upper(self, bi, bj, out) -> None:
+        """out (the values of an SBAIJ matrix of the nodal upper block pattern ``bi``, ``bj``,
+        column-major blocks) = the form's tangent, one rank: the upper triangle of the matrix that
+        :meth:`assemble` adds into the AIJ matrix, to the last bit, without the AIJ matrix (the node
+        pairs of a cell on or above the diagonal: 36 of the 64 blocks of a hexahedron). Raises
+        RuntimeError if the pattern lacks a block the form needs."""
+        module = compiled()
+        ffi, lib = module.ffi, module.lib
+
+        def ptr(kind, a):
+            return ffi.cast(kind + "*", a.ctypes.data)
+
+        c = np.ascontiguousarray(self.constants(), dtype=np.float64)
+        if c.size == 0:
+            c = np.zeros(1)
+        packed = self.coefficients()
+        nb = self.blocks.shape[1]
+        n = nb * self.bs
+        Ae = np.empty(n * n)
+        X = np.empty(3 * self.geometry.shape[1])
+        held = self.constrained.view(np.uint8)
+        if self.upper_maps is None:
+            self.upper_maps = [np.full((len(cells), nb * nb), -1, dtype=np.int32) for _, cells, _ in self.integrals]
+        out[:] = 0.0
+        missing = 0
+        for (address, cells, key), known in zip(self.integrals, self.upper_maps):
+            w = np.ascontiguousarray(packed[key], dtype=np.float64)
+            if w.size == 0:
+                w = np.zeros((len(cells), 1))
+            missing += lib.add_cells_upper(address, len(cells), ptr("int32_t", cells), nb, ptr("int32_t", self.blocks),
+                                           self.geometry.shape[1], ptr("int32_t", self.geometry), ptr("double", self.x),
+                                           ptr("double", w), w.shape[1] if w.size else 0, ptr("double", c),
+                                           ptr("uint8_t", held), self.bs, ptr("int32_t", bi), ptr("int32_t", bj),
+                                           ptr("double", out), ptr("double", Ae), ptr("double", X),
+                                           ptr("int32_t", known))
+        missing += lib.set_constrained_upper(len(bi) - 1, self.bs, ptr("int32_t", bi), ptr("int32_t", bj),
+                                             ptr("uint8_t", held), ptr("double", out))
+        if missing:
+            raise RuntimeError(f"the SBAIJ pattern lacks {missing} blocks of the form")
+
+
+def aij_from_upper(bi, bj, S, bs: int, indptr, indices, values) -> None:
+    """values (a symmetric AIJ matrix's CSR values; sorted columns) = the matrix whose upper block
+    triangle is the SBAIJ values ``S`` (pattern ``bi``, ``bj``, column-major blocks of ``bs``),
+    the lower triangle its mirror image; raises RuntimeError where the AIJ pattern lacks entries."""
+    module = compiled()
+    ffi, lib = module.ffi, module.lib
+
+    def ptr(kind, a):
+        return ffi.cast(kind + "*", a.ctypes.data)
+
+    cursor = np.empty(len(indptr) - 1, dtype=np.int64)
+    missing = lib.aij_from_upper(len(bi) - 1, bs, ptr("int32_t", bi), ptr("int32_t", bj), ptr("double", S),
+                                 ptr("int32_t", indptr), ptr("int32_t", indices), ptr("double", values),
+                                 ptr("int64_t", cursor))
+    if missing:
+        raise RuntimeError(f"the AIJ pattern lacks {missing} entries of the SBAIJ matrix")
+
+
 def diagonal(indptr, indices, values) -> np.ndarray:
     """The diagonal entries of the CSR rows (indptr, indices, values) (0 where a row lacks one):
     those of an AIJ matrix, or of the owned block of an MPIAIJ one (local columns)."""
@@ -601,6 +863,19 @@ def diagonal(indptr, indices, values) -> np.ndarray:
         lib.diagonal(len(out), ffi.cast("int32_t*", indptr.ctypes.data), ffi.cast("int32_t*", indices.ctypes.data),
                      ffi.cast("double*", values.ctypes.data), ffi.cast("double*", out.ctypes.data))
     return out
+
+
+def set_diagonal(indptr, indices, values, diag) -> None:
+    """The diagonal entries of the CSR rows (indptr, indices, values) set to ``diag``; raises
+    RuntimeError where a row lacks one."""
+    module = compiled()
+    ffi, lib = module.ffi, module.lib
+    diag = np.ascontiguousarray(diag, dtype=np.float64)
+    missing = lib.set_diagonal(len(indptr) - 1, ffi.cast("int32_t*", indptr.ctypes.data),
+                               ffi.cast("int32_t*", indices.ctypes.data), ffi.cast("double*", diag.ctypes.data),
+                               ffi.cast("double*", values.ctypes.data))
+    if missing:
+        raise RuntimeError(f"{missing} rows lack their diagonal entry")
 
 
 def upper_blocks(indptr, indices, values, bs: int, bi, bj, out) -> None:

@@ -201,6 +201,11 @@ class SymmetricBlockOperator:
         self.S = S
         self._state = None
         self._compiled = None
+        # the tangent assembled straight into S (:meth:`assemble_upper`): A's values are made from
+        # S only when something reads A (:meth:`sync`: the AMG's set-up, a fallback LU)
+        self.upper_newer = False
+        self.assembled = False  # whether a tangent was ever assembled into S alone
+        self._diagonal = None
         if self.serial:
             from . import cells
 
@@ -243,8 +248,68 @@ class SymmetricBlockOperator:
         np.cumsum(counts, out=bi[1:])
         return bi, np.concatenate(columns) if columns else np.zeros(0, dtype=PETSc.IntType)
 
+    def _upper_values(self, action) -> None:
+        """action(values of S, (blocks × bs², column-major blocks)) on one rank; S's state changes."""
+        ctypes, lib, _, _ = _petsc_library()
+        handle, v = ctypes.c_void_p(self.S.handle), ctypes.POINTER(ctypes.c_double)()
+        if lib.MatSeqSBAIJGetArray(handle, ctypes.byref(v)):
+            raise RuntimeError("MatSeqSBAIJGetArray failed")
+        try:
+            action(np.ctypeslib.as_array(v, shape=(int(self.bi[-1]) * self.bs ** 2,)))
+        finally:
+            lib.MatSeqSBAIJRestoreArray(handle, ctypes.byref(v))
+
+    @property
+    def direct(self) -> bool:
+        """Whether a tangent can be assembled into S itself (one rank, the compiled loops)."""
+        return self._compiled is not None
+
+    def assemble_upper(self, assemble) -> None:
+        """S's values = ``assemble(values)`` (the tangent's upper block triangle, written in place:
+        :meth:`dolfinx_corot.assembly.cells.CellAssembler.assemble_upper`); A's values are now
+        out of date until :meth:`sync`. The diagonal is kept (:meth:`diagonal`)."""
+        bs = self.bs
+
+        def action(values):
+            assemble(values)
+            self._diagonal = values.reshape(-1, bs * bs)[self.bi[:-1], :: bs + 1].ravel()
+
+        self._upper_values(action)
+        self.upper_newer = True
+        self.assembled = True
+        # A's diagonal follows (its state changes): the Jacobi smoothers of a kept hierarchy,
+        # which read A's diagonal, take each new tangent's as they did when A was assembled
+        from . import cells
+
+        with SeqAIJArrays(self.A, write=True) as (indptr, indices, a):
+            cells.set_diagonal(indptr, indices, a, self._diagonal)
+        self._state = self.A.stateGet()
+
+    def sync(self) -> None:
+        """A = S and its mirror image (A's pattern, lower triangle included), where S was assembled
+        after A; A's state changes, so that preconditioners set up from it anew."""
+        if not self.upper_newer:
+            return
+        from . import cells
+
+        def mirror(values):
+            with SeqAIJArrays(self.A, write=True) as (indptr, indices, a):
+                cells.aij_from_upper(self.bi, self.bj, values, self.bs, indptr, indices, a)
+
+        self._upper_values(mirror)
+        self.upper_newer = False
+        self._state = self.A.stateGet()
+
+    def diagonal(self) -> np.ndarray:
+        """The diagonal of the tangent last assembled by :meth:`assemble_upper`: its diagonal
+        blocks' diagonals (the diagonal block is the first of its block row)."""
+        return self._diagonal
+
     def refresh(self) -> None:
-        """S = A's upper triangle, if A changed since the last refresh."""
+        """S = A's upper triangle, if A changed since the last refresh (nothing to do when S was
+        assembled after A: :meth:`assemble_upper`)."""
+        if self.upper_newer:
+            return
         state = self.A.stateGet()
         if state == self._state:
             return
@@ -502,6 +567,7 @@ class LinearSolver:
                            and PETSc.Options().getBool(options_prefix + "amg_corotate", True))
         self._take_prolongator = self.corotation
         self.solves = 0  # iterative solves
+        self._reusing = False  # the preconditioner is kept for the next solve (not set up from A)
         self.mumps = self.ksp.getType() == "preonly" and pc.getType() in ("lu", "cholesky") \
             and pc.getFactorSolverType() == "mumps"
         self.ldlt = self.mumps and pc.getType() == "cholesky"
@@ -548,11 +614,12 @@ class LinearSolver:
             self._dense_factorize()
             self.dense.solve(rhs, out)
             return
-        if self._block_operator:
-            if self.operator is None:
-                self.operator = SymmetricBlockOperator(self.A)
-                self.ksp.setOperators(self.operator.S, self.A)
-            self.operator.refresh()
+        operator = self.block_operator()
+        setup = not self._reusing
+        if operator is not None:
+            operator.refresh()
+            if setup:  # the preconditioner is set up from A: A's values from S
+                operator.sync()
         self.ksp.solve(rhs, out)
         reason = self.ksp.getConvergedReason()
         if self.iterative:
@@ -582,7 +649,21 @@ class LinearSolver:
                     f"the tangent stiffness is singular ({null_pivots} zero pivot(s)): a missing support "
                     "(rigid-body motion), a mechanism, or a limit point under load control")
 
+    def block_operator(self) -> SymmetricBlockOperator | None:
+        """The upper block triangle CG and the smoothers apply (made on first use from A's
+        pattern), or None where CG reads A itself."""
+        if self._block_operator and self.operator is None:
+            self.operator = SymmetricBlockOperator(self.A)
+            self.ksp.setOperators(self.operator.S, self.A)
+        return self.operator
+
+    def sync_aij(self) -> None:
+        """A's values from the block operator, where the tangent was assembled into it alone."""
+        if self.operator is not None:
+            self.operator.sync()
+
     def _direct_solve(self, rhs: PETSc.Vec, out: PETSc.Vec) -> int:
+        self.sync_aij()
         if self._fallback is None:
             self._fallback = PETSc.KSP().create(self.comm)
             self._fallback.setType("preonly")
@@ -617,6 +698,7 @@ class LinearSolver:
             pc.setFromOptions()
         self.prolongator = None
         self._take_prolongator = self.corotation
+        self._reusing = False  # a new preconditioner is set up at the next solve
 
     def _keep_prolongator(self) -> None:
         """After the first solve with a new GAMG hierarchy: its finest prolongator, to be
@@ -649,12 +731,14 @@ class LinearSolver:
         if lib.PCGAMGSetReuseInterpolation(ctypes.c_void_p(pc.handle), ctypes.c_int(1)):
             raise RuntimeError("PCGAMGSetReuseInterpolation failed")
         pc.setReusePreconditioner(True)
+        self._reusing = True
         return True
 
     def reuse_preconditioner(self, reuse: bool) -> None:
         """Keep the preconditioner of an earlier tangent for the next iterative solves."""
         if self.iterative:
             self.ksp.getPC().setReusePreconditioner(bool(reuse))
+            self._reusing = bool(reuse)
 
     def negative_eigenvalues(self) -> int | None:
         """Number of negative eigenvalues of the last factorized tangent (LDLᵀ only; else None)."""
@@ -707,6 +791,7 @@ class LinearSolver:
     def _symmetric_copy(self, scale_constrained: np.ndarray | None = None) -> PETSc.Mat:
         """½(A + Aᵀ) as AIJ; the rows and columns ``scale_constrained`` (global) get the diagonal
         max|diag A| instead of 1, so that supports do not pose as soft modes."""
+        self.sync_aij()
         A = self.A
         S = A.copy()
         T = A.transpose(PETSc.Mat())

@@ -96,6 +96,15 @@ class System:
     """
 
     _cells = None  # the compiled assembly of the parts' tangent (assembly.cells), where it serves
+    linear = None
+
+    @property
+    def A(self) -> PETSc.Mat:
+        """The tangent as an AIJ matrix. Where the iterative solver's symmetric block operator
+        alone was assembled (:meth:`_assemble_parts_matrix`), A's values are made from it first."""
+        if self.linear is not None:
+            self.linear.sync_aij()
+        return self._A
 
     def __init__(self, model: Model, options_prefix: str = "dc_newton_", symmetric: bool | None = None,
                  solver: str = "direct", contributions: Sequence[Contribution] = (), tangent: str = "auto"):
@@ -150,7 +159,10 @@ class System:
         prolongator = None
         if self.iterative and model.large_rotations and hasattr(model, "patch_rotations"):
             from .amg import CorotatedProlongator as prolongator
-        self.linear = petsc.LinearSolver(self.comm, self.A, self.iterative, symmetric, options_prefix, nullspace,
+        # the tangent assembled into the iterative solver's upper block triangle alone where it
+        # can be (:meth:`_upper_operator`; ``-<prefix>upper_assembly false``: into A, then copied)
+        self._upper_assembly = PETSc.Options().getBool(options_prefix + "upper_assembly", True)
+        self.linear = petsc.LinearSolver(self.comm, self._A, self.iterative, symmetric, options_prefix, nullspace,
                                          fixed_rtol=not model.large_rotations, prolongator=prolongator)
         self._current_modes = self.iterative and model.large_rotations
         self._modes_version = self._version
@@ -170,7 +182,7 @@ class System:
         self.L, self.a = self.model.forms()
         self._test_space = self.a.function_spaces[0]
         self.bcs = self.model.dirichlet_bcs()
-        self.A = petsc.form_matrix(self.a, self._mat_type)
+        self._A = petsc.form_matrix(self.a, self._mat_type)
         self.b = petsc.form_vector(self.L)
         # a large continuum's tangent is assembled into A's values by a compiled loop
         # (:mod:`.cells`) once DOLFINx's first assembly has laid out A's pattern
@@ -401,17 +413,20 @@ class System:
         """The owned diagonal of A: read by the compiled loop where it assembles A (bisection in
         each row; PETSc's MatGetDiagonal scans rows from their start, 14 ms on the 116 k-dof
         block against 1 ms), else PETSc's."""
-        if self._cells is not None and self.A.getType() in ("seqaij", "mpiaij"):
+        operator = self._upper_operator()
+        if operator is not None and operator.upper_newer:
+            return operator.diagonal()
+        if self._cells is not None and self._A.getType() in ("seqaij", "mpiaij"):
             from . import cells
 
             if self.comm.size == 1:
-                with petsc.SeqAIJArrays(self.A, write=False) as (indptr, indices, values):
+                with petsc.SeqAIJArrays(self._A, write=False) as (indptr, indices, values):
                     return cells.diagonal(indptr, indices, values)
-            with petsc.MPIAIJArrays(self.A, write=False) as ((indptr, indices, values), _, _):
+            with petsc.MPIAIJArrays(self._A, write=False) as ((indptr, indices, values), _, _):
                 return cells.diagonal(indptr, indices, values)
         if self._diagonal is None:
-            self._diagonal = self.A.createVecLeft()
-        self.A.getDiagonal(self._diagonal)
+            self._diagonal = self._A.createVecLeft()
+        self._A.getDiagonal(self._diagonal)
         return self._diagonal.array_r
 
     def correction_norms(self) -> dict[str, tuple[float, float]]:
@@ -422,24 +437,40 @@ class System:
             out["moment"] = (sq[1], sq[3])
         return out
 
+    def _upper_operator(self):
+        """The iterative solver's symmetric block operator where the tangent is assembled into it
+        alone (one rank, the compiled assembly, CG on the upper block triangle; the solver has no
+        contributions), else None. The AIJ matrix A is then filled from it only where it is read:
+        the AMG's set-up (once on the SVK block of benchmarks/block3d.py, whose hierarchy is kept
+        and co-rotated), a fallback LU, the stability checks (:attr:`A`)."""
+        if (self._cells is None or self.comm.size > 1 or not self.iterative or self.contributions
+                or not self._upper_assembly):
+            return None
+        operator = self.linear.block_operator()
+        return operator if operator is not None and operator.direct else None
+
     def _assemble_parts_matrix(self) -> None:
         if self._cells is not None:
+            operator = self._upper_operator()
+            if operator is not None:
+                operator.assemble_upper(lambda out: self._cells.assemble_upper(operator.bi, operator.bj, out))
+                return
             if self.comm.size == 1:
-                with petsc.SeqAIJArrays(self.A) as (indptr, indices, values):
+                with petsc.SeqAIJArrays(self._A) as (indptr, indices, values):
                     values[:] = 0.0
                     self._cells.assemble(indptr, indices, values)
                 return
-            with petsc.MPIAIJArrays(self.A) as ((indptr, indices, values), (ip, ix, v), colmap):
+            with petsc.MPIAIJArrays(self._A) as ((indptr, indices, values), (ip, ix, v), colmap):
                 values[:] = 0.0
                 v[:] = 0.0
                 rows, columns, ghost = self._cells.assemble(indptr, indices, values, (ip, ix, v, colmap))
             if len(rows):  # the rows of ghost nodes, to their owners
-                self.A.setValuesBlockedLocalRCV(rows, columns, ghost, addv=PETSc.InsertMode.ADD_VALUES)
-            self.A.assemble()
+                self._A.setValuesBlockedLocalRCV(rows, columns, ghost, addv=PETSc.InsertMode.ADD_VALUES)
+            self._A.assemble()
             return
-        self.A.zeroEntries()
-        _dolfinx.assemble_matrix_with_bcs(self.A, self.a, self.bcs, self._test_space)
-        self.A.assemble()
+        self._A.zeroEntries()
+        _dolfinx.assemble_matrix_with_bcs(self._A, self.a, self.bcs, self._test_space)
+        self._A.assemble()
         if not self._cells_checked:
             self._cells_checked = True
             self._cells = self._cell_assembler()
@@ -454,7 +485,7 @@ class System:
 
         parts = None
         try:
-            if self.A.getType() in ("seqaij", "mpiaij") and np.dtype(PETSc.IntType) == np.int32:
+            if self._A.getType() in ("seqaij", "mpiaij") and np.dtype(PETSc.IntType) == np.int32:
                 parts = _dolfinx.cell_integrals(self.a, self.bcs)
             ok = parts is not None and sum(len(c) for _, c, _ in parts[0]) >= cells.MIN_CELLS
             if ok:
@@ -494,7 +525,7 @@ class System:
         if not self.engaged:
             return
         t = time.perf_counter()
-        A = self.A
+        A = self._A
         if self.C is None or any(c.couplings_changed for c in self.contributions):
             self._build_couplings(A)
         C = self.C
@@ -949,7 +980,7 @@ class System:
     # -- numbering ------------------------------------------------------------------
     def global_dofs(self, model, local_dofs: np.ndarray) -> np.ndarray:
         """Global system dofs of ``model``'s local unrolled dofs."""
-        return self.A.getLGMap()[0].apply(np.asarray(local_dofs, dtype=PETSc.IntType)).astype(np.int64)
+        return self._A.getLGMap()[0].apply(np.asarray(local_dofs, dtype=PETSc.IntType)).astype(np.int64)
 
     def touched_by_others(self, model) -> np.ndarray:
         """(local blocks of ``model``) whether an existing element of another model touches the
@@ -963,7 +994,7 @@ class System:
         return np.unique(own if self.comm.size == 1 else np.concatenate(self.comm.allgather(own)))
 
     def ownership_range(self) -> tuple[int, int]:
-        return self.A.getOwnershipRange()
+        return self._A.getOwnershipRange()
 
     def internal_force(self) -> PETSc.Vec:
         """f_int at the last residual, all dofs: on supported dofs it is the reaction."""
@@ -973,7 +1004,7 @@ class System:
         for c in self.contributions:
             c.destroy()
         self.linear.destroy()
-        petsc.destroy(self.fload, self.C, self.A, self.b, self.fint, self.dx, self.step_dx, self.lift, self.fext,
+        petsc.destroy(self.fload, self.C, self._A, self.b, self.fint, self.dx, self.step_dx, self.lift, self.fext,
                       self.fext_total, self._rhs, *(v for _, v in self.amplitude_loads))
 
 
@@ -996,7 +1027,7 @@ class CoupledSystem(System):
         for m, loc in zip(models, lay.local):
             cells = m.V.dofmap.list.array.reshape(-1, m.nodes_per_cell)
             blocks.append(loc[(cells[:, :, None] * m.ndof + np.arange(m.ndof)).reshape(len(cells), -1)])
-        self.A = petsc.layout_matrix(comm, lay.imap, blocks, lay.n_owned)
+        self._A = petsc.layout_matrix(comm, lay.imap, blocks, lay.n_owned)
         self.b = petsc.layout_vector(lay.imap)
         self._diagonal_kept = False
         self._model_forms = [m.forms() for m in models]
@@ -1168,7 +1199,7 @@ class CoupledSystem(System):
         self._lift_pending = True
 
     def _assemble_parts_matrix(self) -> None:
-        A = self.A
+        A = self._A
         A.zeroEntries()
         lg0 = A.getLGMap()
         for (_, a), lg in zip(self._model_forms, self._lgmaps):
@@ -1189,9 +1220,9 @@ class CoupledSystem(System):
     def _constrain_matrix(self) -> None:
         rows = (self._fixed + self.layout.start).astype(PETSc.IntType)
         if self._lift_pending and self.has_prescribed_motion:
-            self.A.zeroRowsColumns(rows, 1.0, self.lift, self.b)
+            self._A.zeroRowsColumns(rows, 1.0, self.lift, self.b)
         else:
-            self.A.zeroRowsColumns(rows, 1.0)
+            self._A.zeroRowsColumns(rows, 1.0)
         self._lift_pending = False
 
     def reference_load(self, out: PETSc.Vec) -> None:

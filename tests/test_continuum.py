@@ -443,6 +443,18 @@ def test_cg_reads_the_tangent_s_upper_triangle_in_nodal_blocks(n, degree):
     system.destroy()
 
 
+def _block_system_with_option(name: str, value: str):
+    """The bent cantilever block and its iterative system made while the PETSc option ``name``
+    is ``value`` (the option is removed afterwards)."""
+    options = PETSc.Options()
+    options[name] = value
+    try:
+        sc = _cantilever_block()
+        return sc, make_system(sc.model, solver="iterative")
+    finally:
+        del options[name]
+
+
 @pytest.mark.parametrize("n, degree", [((6, 2, 2), 1), ((3, 1, 1), 2), ((6, 3), 2)],
                          ids=["hex-Q1", "hex-Q2", "plane-Q2"])
 def test_the_tangent_assembled_into_its_upper_block_triangle_alone_is_the_copied_one(monkeypatch, n, degree):
@@ -521,13 +533,7 @@ def test_the_newton_path_on_the_upper_block_triangle_alone_is_the_path_on_the_co
     op_class = petsc.SymmetricBlockOperator
     original = op_class.sync
     for name, value in (("upper", "true"), ("copied", "false")):
-        options = PETSc.Options()
-        options["dc_newton_upper_assembly"] = value
-        try:
-            sc = _cantilever_block()
-            system = make_system(sc.model, solver="iterative")
-        finally:
-            del options["dc_newton_upper_assembly"]
+        sc, system = _block_system_with_option("dc_newton_upper_assembly", value)
         calls = []
         monkeypatch.setattr(op_class, "sync", lambda self: (calls.append(self.upper_newer), original(self))[1])
         res = dc.solve(sc, dc.LoadControl(steps=2, extrapolate=True), system=system)
@@ -550,13 +556,7 @@ def test_the_newton_path_on_the_block_operator_is_the_path_on_the_aij_tangent():
     to 1e-8 in as many Krylov iterations (within 2: the products' round-off differs)."""
     tips, krylov = {}, {}
     for name, value in (("blocks", "true"), ("aij", "false")):
-        options = PETSc.Options()
-        options["dc_newton_block_operator"] = value
-        try:
-            sc = _cantilever_block()
-            system = make_system(sc.model, solver="iterative")
-        finally:
-            del options["dc_newton_block_operator"]
+        sc, system = _block_system_with_option("dc_newton_block_operator", value)
         res = dc.solve(sc, dc.LoadControl(steps=2, extrapolate=True), system=system)
         assert (system.linear.operator is not None) == (name == "blocks")
         assert system.linear.ksp.getOperators()[0].getType().endswith("sbaij") == (name == "blocks")

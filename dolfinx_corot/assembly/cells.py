@@ -69,6 +69,25 @@ static int64_t find(const int32_t* indices, int64_t lo, int64_t hi, int64_t colu
   return (lo < stop && indices[lo] == column) ? lo : -1;
 }
 
+/* The element matrix of the k-th cell of ``cells`` into Ae (n x n, row-major; X: its geometry's
+   coordinates, work space); returns whether any of its dofs is constrained. */
+static int element_matrix(tabulate_t kernel, int64_t k, const int32_t* cells, int64_t nb, const int32_t* blocks,
+                          int64_t ng, const int32_t* geometry, const double* x, const double* w, int64_t wstride,
+                          const double* c, const uint8_t* constrained, int64_t bs, double* Ae, double* X)
+{
+  const int64_t cell = cells[k], n = nb * bs;
+  const int32_t* nodes = blocks + cell * nb;
+  for (int64_t i = 0; i < ng; ++i)
+    for (int d = 0; d < 3; ++d)
+      X[3 * i + d] = x[3 * (int64_t)geometry[cell * ng + i] + d];
+  memset(Ae, 0, n * n * sizeof(double));
+  kernel(Ae, w + k * wstride, c, X, NULL, NULL);
+  int held = 0;
+  for (int64_t i = 0; i < n; ++i)
+    held |= constrained[nodes[i / bs] * bs + i % bs];
+  return held;
+}
+
 /* The element matrices of ``cells`` added into the rows of owned nodes (node < owned): columns of
    owned nodes into the CSR block (indptr, indices, values) at column node * bs, columns of ghost
    nodes into the CSR block (indptr_o, indices_o, values_o) at column ghost_column[node - owned]
@@ -91,16 +110,9 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
   int64_t missing = 0;
   for (int64_t k = 0; k < ncells; ++k)
   {
-    const int64_t cell = cells[k];
-    const int32_t* nodes = blocks + cell * nb;
-    for (int64_t i = 0; i < ng; ++i)
-      for (int d = 0; d < 3; ++d)
-        X[3 * i + d] = x[3 * (int64_t)geometry[cell * ng + i] + d];
-    memset(Ae, 0, n * n * sizeof(double));
-    kernel(Ae, w + k * wstride, c, X, NULL, NULL);
-    int held = 0;
-    for (int64_t i = 0; i < n; ++i)
-      held |= constrained[nodes[i / bs] * bs + i % bs];
+    const int32_t* nodes = blocks + (int64_t)cells[k] * nb;
+    const int held = element_matrix(kernel, k, cells, nb, blocks, ng, geometry, x, w, wstride, c, constrained,
+                                    bs, Ae, X);
     if (ghost_slot != NULL && ghost_slot[k] >= 0)
     {
       double* g = ghost + ghost_slot[k] * n * n;
@@ -203,16 +215,9 @@ int64_t add_cells_upper(uintptr_t address, int64_t ncells, const int32_t* cells,
   int64_t missing = 0;
   for (int64_t k = 0; k < ncells; ++k)
   {
-    const int64_t cell = cells[k];
-    const int32_t* nodes = blocks + cell * nb;
-    for (int64_t i = 0; i < ng; ++i)
-      for (int d = 0; d < 3; ++d)
-        X[3 * i + d] = x[3 * (int64_t)geometry[cell * ng + i] + d];
-    memset(Ae, 0, n * n * sizeof(double));
-    kernel(Ae, w + k * wstride, c, X, NULL, NULL);
-    int held = 0;
-    for (int64_t i = 0; i < n; ++i)
-      held |= constrained[nodes[i / bs] * bs + i % bs];
+    const int32_t* nodes = blocks + (int64_t)cells[k] * nb;
+    const int held = element_matrix(kernel, k, cells, nb, blocks, ng, geometry, x, w, wstride, c, constrained,
+                                    bs, Ae, X);
     for (int64_t i = 0; i < nb; ++i)
     {
       const int64_t I = nodes[i], k0 = bi[I], k1 = bi[I + 1];
@@ -288,6 +293,30 @@ int64_t set_constrained_upper(int64_t nblocks, int64_t bs, const int32_t* bi, co
   return missing;
 }
 
+/* values at row's columns col0 ... col0 + len - 1 = v[0], v[stride], ..., found from cursor[row] on (the
+   row's columns sorted, visited in increasing order; the cursor moves on); returns the columns
+   the row lacks. */
+static int64_t put_run(int64_t row, int64_t col0, int64_t len, const double* v, int64_t stride,
+                       const int32_t* indptr, const int32_t* indices, double* values, int64_t* cursor)
+{
+  int64_t missing = 0, p = cursor[row];
+  const int64_t stop = indptr[row + 1];
+  for (int64_t b = 0; b < len; ++b)
+  {
+    const int64_t col = col0 + b;
+    while (p < stop && indices[p] < col)
+      ++p;
+    if (p == stop || indices[p] != col)
+    {
+      ++missing;
+      continue;
+    }
+    values[p] = v[b * stride];
+  }
+  cursor[row] = p;
+  return missing;
+}
+
 /* The symmetric AIJ matrix (indptr, indices, values; every row's columns sorted) of the SBAIJ
    values S (upper block pattern bi, bj; column-major blocks): each block at its place in its rows
    and, off the diagonal, transposed in the rows of its column. Entries of the AIJ pattern outside
@@ -307,48 +336,11 @@ int64_t aij_from_upper(int64_t nblocks, int64_t bs, const int32_t* bi, const int
     {
       const int64_t J = bj[k];
       const double* block = S + k * bb;
-      for (int64_t a = 0; a < bs; ++a)
-      {
-        /* row I*bs + a: the block's row a at columns J*bs ... */
-        const int64_t row = I * bs + a;
-        int64_t p = cursor[row];
-        const int64_t stop = indptr[row + 1];
-        for (int64_t b = 0; b < bs; ++b)
-        {
-          const int64_t col = J * bs + b;
-          while (p < stop && indices[p] < col)
-            ++p;
-          if (p == stop || indices[p] != col)
-          {
-            ++missing;
-            continue;
-          }
-          values[p] = block[b * bs + a];
-        }
-        cursor[row] = p;
-      }
-      if (J == I)
-        continue;
-      for (int64_t b = 0; b < bs; ++b)
-      {
-        /* row J*bs + b: the block's column b at columns I*bs ... */
-        const int64_t row = J * bs + b;
-        int64_t p = cursor[row];
-        const int64_t stop = indptr[row + 1];
-        for (int64_t a = 0; a < bs; ++a)
-        {
-          const int64_t col = I * bs + a;
-          while (p < stop && indices[p] < col)
-            ++p;
-          if (p == stop || indices[p] != col)
-          {
-            ++missing;
-            continue;
-          }
-          values[p] = block[b * bs + a];
-        }
-        cursor[row] = p;
-      }
+      for (int64_t a = 0; a < bs; ++a)  /* row I*bs + a: the block's row a at columns J*bs ... */
+        missing += put_run(I * bs + a, J * bs, bs, block + a, bs, indptr, indices, values, cursor);
+      if (J != I)
+        for (int64_t b = 0; b < bs; ++b)  /* row J*bs + b: the block's column b at columns I*bs ... */
+          missing += put_run(J * bs + b, I * bs, bs, block + b * bs, 1, indptr, indices, values, cursor);
     }
   }
   return missing;

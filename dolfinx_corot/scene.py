@@ -19,13 +19,12 @@ from __future__ import annotations
 
 import numbers
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import validate
 from .conditions import Condition
-from .contact.laws import ContactError, Penalty
-from .contact.pair import ContactPair
 from .io.mesh import TaggedMesh
 from .loads import FollowerLoads
 from .materials import Elastic
@@ -35,6 +34,9 @@ from .parts.groups import chain_coordinate
 from .result import Profile
 from .sections import Section
 from .stabilisation import Stabilisation, Stabiliser
+
+if TYPE_CHECKING:  # a scene without contact loads no contact modules
+    from .contact.pair import ContactPair
 
 KINEMATICS = ("bernoulli", "timoshenko")
 
@@ -472,7 +474,9 @@ class Scene:
         depth) and its resultant; see also :meth:`monitor_contact`."""
         from .contact.interface import Interface  # (a scene without contact loads no contact modules)
         from .contact.interface3d import Interface3D
+        from .contact.laws import ContactError, Penalty
         from .contact.mortar import MortarInterface3D
+        from .contact.pair import ContactPair
 
         law = Penalty() if law is None else law
         if discretization not in ("node_to_face", "mortar"):
@@ -659,6 +663,8 @@ class Scene:
         ``on`` side ('slaves' or 'masters'), both passes combined: ``name_Fx``, ``name_Fy`` the
         resultant force the other body exerts on that side, ``name_N`` the total normal force
         Σ p L and ``name_pmax`` the largest nominal pressure on the contact face."""
+        from .contact.pair import ContactPair
+
         if not isinstance(pair, ContactPair):
             raise TypeError(f"monitor_contact '{name}': give what scene.contact returned, got {type(pair).__name__}")
         if not any(pair.interfaces[0] is itf for itf in self.interfaces):

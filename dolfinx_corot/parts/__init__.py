@@ -11,12 +11,11 @@ import numpy as np
 from .base import Motion, Part, PartRef, global_sum, owned_dofs_of_vertices
 from .cells import MeshError
 from .coupled import Coupled
-from .solid import Solid
 from .surface import Surface, SurfaceError
 
-# structures come with their first use: a scene of continua alone loads neither their modules
-# nor numba (53 MB and 0.15 s)
-_LAZY = {"Frame2D": "frame", "Frame3D": "frame", "LineFrame": "frame", "MembraneQuad": "shell", "Shell3D": "shell",
+# part kinds come with their first use: a scene of continua alone loads neither the structures'
+# modules nor numba (53 MB and 0.15 s), a scene of structures alone not the continuum's UFL forms
+_LAZY = {"Solid": "solid", "Frame2D": "frame", "Frame3D": "frame", "LineFrame": "frame", "MembraneQuad": "shell", "Shell3D": "shell",
          "ShellQuad": "shell", "Surface3D": "shell"}
 
 
@@ -45,6 +44,8 @@ def part_for_mesh(tmesh, large_rotations: bool, solid_degree: int | None = None,
         raise ValueError(f"the mesh has node coordinates that are not finite, e.g. {next(f for f in found if f)}: "
                          "check the geometry (gmsh model or arrays) before building parts on it")
     if solid_degree is not None:
+        from .solid import Solid
+
         return Solid(tmesh, solid_degree, large_rotations)
     if mesh.topology.dim == mesh.geometry.dim and mesh.topology.dim > 1:
         raise ValueError("this mesh fills its space (a continuum): use add_solid; structural parts need "

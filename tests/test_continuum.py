@@ -421,7 +421,12 @@ def test_cg_reads_the_tangent_s_upper_triangle_in_nodal_blocks(n, degree):
     op = petsc.SymmetricBlockOperator(A)
     op.refresh()
     dense = [M.convert("dense", PETSc.Mat()) for M in (op.S, reference)]
-    assert np.array_equal(dense[0].getDenseArray(), dense[1].getDenseArray())
+    if MPI.COMM_WORLD.size == 1:
+        assert np.array_equal(dense[0].getDenseArray(), dense[1].getDenseArray())
+    else:  # PETSc's MPI conversion keeps a diagonal block's lower entries, ours its upper ones,
+        # as on one rank: the two differ by the tangent's round-off asymmetry
+        scale = np.abs(dense[1].getDenseArray()).max()
+        assert np.abs(dense[0].getDenseArray() - dense[1].getDenseArray()).max() <= 1e-14 * scale
     x, y, z = A.createVecRight(), A.createVecLeft(), A.createVecLeft()
     x.setRandom()
     A.mult(x, y)
@@ -465,8 +470,9 @@ def test_the_tangent_assembled_into_its_upper_block_triangle_alone_is_the_copied
     the diagonal the residual's round-off floor reads, which is written into A as well (the
     smoothers of a kept AMG hierarchy read it there); A's other values are made from S only when
     A is read (``System.A``), then the assembled AIJ tangent: its upper triangle to the last bit,
-    its lower one to round-off (the mirror image of the upper). On several ranks the AIJ tangent
-    is assembled as before."""
+    its lower one to round-off (the mirror image of the upper). On several ranks the same, to
+    round-off: the owned columns go into S's diagonal block, the higher ranks' columns and the
+    rows of ghost nodes by PETSc's insertion (sums in another order than the AIJ assembly's)."""
     from dolfinx_corot.assembly import cells
 
     monkeypatch.setattr(cells, "MIN_CELLS", 0)
@@ -486,11 +492,13 @@ def test_the_tangent_assembled_into_its_upper_block_triangle_alone_is_the_copied
     system.residual(0.5)
     system.jacobian()
     op = system.linear.operator
-    if comm.size > 1:
-        assert system._upper_operator() is None and (op is None or not op.assembled)
-        system.destroy()
-        return
     assert op.upper_newer and op.assembled
+
+    def same(a, b):
+        if comm.size == 1:
+            return np.array_equal(a, b)
+        return a.shape == b.shape and np.allclose(a, b, rtol=0.0, atol=1e-14 * max(np.abs(b).max(initial=0.0), 1e-300))
+
     state = system._A.stateGet()
     direct = op.S.convert("dense", PETSc.Mat()).getDenseArray().copy()
     diagonal = system._tangent_diagonal().copy()
@@ -507,25 +515,27 @@ def test_the_tangent_assembled_into_its_upper_block_triangle_alone_is_the_copied
     assert np.array_equal(indptr, mirrored[0]) and np.array_equal(indices, mirrored[1])
     rows = np.repeat(np.arange(len(indptr) - 1), np.diff(indptr))
     bs = A.getBlockSize()
+    rows += A.getOwnershipRange()[0]
     upper = (indices // bs > rows // bs) | ((indices // bs == rows // bs) & (indices >= rows))
-    assert np.array_equal(mirrored[2][upper], values[upper])
+    assert same(mirrored[2][upper], values[upper])
     assert np.allclose(mirrored[2], values, rtol=0.0, atol=1e-14 * np.abs(values).max())
     A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     reference = A.convert("sbaij", PETSc.Mat())
-    assert np.array_equal(direct, reference.convert("dense", PETSc.Mat()).getDenseArray())
-    assert np.array_equal(diagonal, A.getDiagonal().array)
+    assert same(direct, reference.convert("dense", PETSc.Mat()).getDenseArray())
+    assert same(diagonal, A.getDiagonal().array)
     reference.destroy()
     system.destroy()
 
 
 def test_the_newton_path_on_the_upper_block_triangle_alone_is_the_path_on_the_copied_one(monkeypatch):
     """The bent cantilever block (12 × 2 × 2, two steps, CG + AMG kept and co-rotated) with its
-    tangents assembled into the upper block triangle alone (the default on one rank) and into the
-    AIJ matrix then copied (``-dc_newton_upper_assembly false``): the same path to the last bit
+    tangents assembled into the upper block triangle alone (the default) and into the AIJ matrix
+    then copied (``-dc_newton_upper_assembly false``): on one rank the same path to the last bit
     (tip, Newton and Krylov iterations: CG, its preconditioner's build and its kept smoothers see
-    the same numbers); the AIJ matrix is filled from the operator only where it is read: here for
-    the inertia of each converged step's tangent (a model this small has its critical points
-    tracked), and never in between."""
+    the same numbers), on several to round-off (the interface's sums in another order); the AIJ
+    matrix is filled from the operator only where it is read: here for the inertia of each
+    converged step's tangent (a model this small has its critical points tracked), and never in
+    between."""
     from dolfinx_corot.assembly import cells, petsc
 
     monkeypatch.setattr(cells, "MIN_CELLS", 0)
@@ -538,16 +548,20 @@ def test_the_newton_path_on_the_upper_block_triangle_alone_is_the_path_on_the_co
         monkeypatch.setattr(op_class, "sync", lambda self: (calls.append(self.upper_newer), original(self))[1])
         res = dc.solve(sc, dc.LoadControl(steps=2, extrapolate=True), system=system)
         monkeypatch.setattr(op_class, "sync", original)
-        assert system.linear.operator.assembled == (name == "upper" and comm.size == 1)
+        assert system.linear.operator.assembled == (name == "upper")
         tips[name] = res.history.column("tip_uy")[-1]
         newton[name] = res.totals["newton_iterations"]
         krylov[name] = system.krylov_iterations
         syncs[name] = sum(calls)  # the syncs that made A from S
         system.destroy()
-    assert tips["upper"] == tips["copied"]
+    if comm.size == 1:
+        assert tips["upper"] == tips["copied"]
+        assert krylov["upper"] == krylov["copied"]
+    else:
+        assert tips["upper"] == pytest.approx(tips["copied"], rel=1e-9)
+        assert abs(krylov["upper"] - krylov["copied"]) <= 2
     assert newton["upper"] == newton["copied"]
-    assert krylov["upper"] == krylov["copied"]
-    assert syncs["copied"] == 0 and syncs["upper"] == (2 if comm.size == 1 else 0)
+    assert syncs["copied"] == 0 and syncs["upper"] == 2
 
 
 def test_the_newton_path_on_the_block_operator_is_the_path_on_the_aij_tangent():

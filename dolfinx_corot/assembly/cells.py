@@ -88,6 +88,19 @@ static int element_matrix(tabulate_t kernel, int64_t k, const int32_t* cells, in
   return held;
 }
 
+/* g = the element matrix Ae (n x n) with its constrained rows and columns zero: a cell's matrix
+   whose rows of ghost nodes go to their owners. */
+static void copy_for_owners(double* g, const double* Ae, const int32_t* nodes, int64_t n, const uint8_t* constrained,
+                            int64_t bs)
+{
+  for (int64_t i = 0; i < n; ++i)
+  {
+    const int row_held = constrained[nodes[i / bs] * bs + i % bs];
+    for (int64_t j = 0; j < n; ++j)
+      g[i * n + j] = (row_held || constrained[nodes[j / bs] * bs + j % bs]) ? 0.0 : Ae[i * n + j];
+  }
+}
+
 /* The element matrices of ``cells`` added into the rows of owned nodes (node < owned): columns of
    owned nodes into the CSR block (indptr, indices, values) at column node * bs, columns of ghost
    nodes into the CSR block (indptr_o, indices_o, values_o) at column ghost_column[node - owned]
@@ -114,15 +127,7 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
     const int held = element_matrix(kernel, k, cells, nb, blocks, ng, geometry, x, w, wstride, c, constrained,
                                     bs, Ae, X);
     if (ghost_slot != NULL && ghost_slot[k] >= 0)
-    {
-      double* g = ghost + ghost_slot[k] * n * n;
-      for (int64_t i = 0; i < n; ++i)
-      {
-        const int row_held = constrained[nodes[i / bs] * bs + i % bs];
-        for (int64_t j = 0; j < n; ++j)
-          g[i * n + j] = (row_held || constrained[nodes[j / bs] * bs + j % bs]) ? 0.0 : Ae[i * n + j];
-      }
-    }
+      copy_for_owners(ghost + ghost_slot[k] * n * n, Ae, nodes, n, constrained, bs);
     for (int64_t i = 0; i < nb; ++i)
     {
       if (nodes[i] >= owned)
@@ -195,20 +200,26 @@ int64_t add_cells(uintptr_t address, int64_t ncells, const int32_t* cells, int64
   return missing;
 }
 
-/* The element matrices of ``cells`` (one rank, every node owned) added into the values ``out`` of
-   an SBAIJ matrix of the upper nodal block pattern (bi, bj; column-major bs x bs blocks, the
-   diagonal block whole: its upper triangle and the mirror image of that), as
-   :c:func:`upper_blocks` would copy them from the AIJ matrix that :c:func:`add_cells` assembles,
-   to the last bit (the same sums in the same order): only the node pairs (i, j) of a cell with
-   nodes[i] <= nodes[j]. Rows and columns of constrained dofs are left out. map: for each cell and
-   pair of its nodes, the block's place in the node's block row (from the row's start; -1: not
-   known), kept from call to call and checked at each use. Returns the number of blocks the
+/* The element matrices of ``cells`` added into the values ``out`` of an SBAIJ matrix of the upper
+   nodal block pattern (bi, bj; column-major bs x bs blocks, the diagonal block whole: its upper
+   triangle and the mirror image of that), as :c:func:`upper_blocks` would copy them from the AIJ
+   matrix that :c:func:`add_cells` assembles, to the last bit (the same sums in the same order):
+   only the node pairs (i, j) of a cell with nodes[i] <= nodes[j]. Rows and columns of constrained
+   dofs are left out. map: for each cell and pair of its nodes, the block's place in the node's
+   block row (from the row's start; -1: not known), kept from call to call and checked at each use.
+   Several ranks (global != NULL): the rows of the owned nodes (node < owned) alone, the pairs
+   ordered by their global block indices ``global``; (bi, bj) is then the diagonal block of the
+   owned columns (local indices), and the blocks of ghost nodes' columns above the diagonal go to
+   the values out_o (row-major blocks) of the block CSR (oi, oj; global block columns); the element
+   matrix of the k-th cell goes whole to ghost + ghost_slot[k] * n * n as well where
+   ghost_slot[k] >= 0, for the rows of its ghost nodes' owners. Returns the number of blocks the
    pattern lacks. */
 int64_t add_cells_upper(uintptr_t address, int64_t ncells, const int32_t* cells, int64_t nb,
                         const int32_t* blocks, int64_t ng, const int32_t* geometry, const double* x,
                         const double* w, int64_t wstride, const double* c, const uint8_t* constrained,
                         int64_t bs, const int32_t* bi, const int32_t* bj, double* out, double* Ae, double* X,
-                        int32_t* map)
+                        int32_t* map, int64_t owned, const int64_t* global, const int32_t* oi,
+                        const int32_t* oj, double* out_o, double* ghost, const int64_t* ghost_slot)
 {
   tabulate_t kernel = (tabulate_t)address;
   const int64_t n = nb * bs, bb = bs * bs;
@@ -218,28 +229,38 @@ int64_t add_cells_upper(uintptr_t address, int64_t ncells, const int32_t* cells,
     const int32_t* nodes = blocks + (int64_t)cells[k] * nb;
     const int held = element_matrix(kernel, k, cells, nb, blocks, ng, geometry, x, w, wstride, c, constrained,
                                     bs, Ae, X);
+    if (ghost_slot != NULL && ghost_slot[k] >= 0)
+      copy_for_owners(ghost + ghost_slot[k] * n * n, Ae, nodes, n, constrained, bs);
     for (int64_t i = 0; i < nb; ++i)
     {
-      const int64_t I = nodes[i], k0 = bi[I], k1 = bi[I + 1];
+      const int64_t I = nodes[i];
+      if (global != NULL && I >= owned)
+        continue; /* a ghost node's rows: its owner's */
+      const int64_t gI = global == NULL ? I : global[I];
       for (int64_t j = 0; j < nb; ++j)
       {
         const int64_t J = nodes[j];
-        if (J < I)
+        const int off = global != NULL && J >= owned;
+        const int64_t gJ = global == NULL ? J : global[J];
+        if (gJ < gI)
           continue;
+        const int32_t* rows = off ? oi : bi;
+        const int32_t* columns = off ? oj : bj;
+        const int64_t column = off ? gJ : J, k0 = rows[I], k1 = rows[I + 1];
         int32_t* known = map + (k * nb + i) * nb + j;
-        int64_t at = *known >= 0 && k0 + *known < k1 && bj[k0 + *known] == J ? k0 + *known : -1;
+        int64_t at = *known >= 0 && k0 + *known < k1 && columns[k0 + *known] == column ? k0 + *known : -1;
         if (at < 0)
         {
           int64_t lo = k0, hi = k1;
           while (lo < hi)
           {
             const int64_t mid = (lo + hi) / 2;
-            if (bj[mid] < J)
+            if (columns[mid] < column)
               lo = mid + 1;
             else
               hi = mid;
           }
-          if (lo == k1 || bj[lo] != J)
+          if (lo == k1 || columns[lo] != column)
           {
             ++missing;
             continue;
@@ -247,7 +268,7 @@ int64_t add_cells_upper(uintptr_t address, int64_t ncells, const int32_t* cells,
           at = lo;
           *known = (int32_t)(lo - k0);
         }
-        double* block = out + at * bb;
+        double* block = (off ? out_o : out) + at * bb;
         for (int64_t a = 0; a < bs; ++a)
         {
           if (held && constrained[I * bs + a])
@@ -257,7 +278,9 @@ int64_t add_cells_upper(uintptr_t address, int64_t ncells, const int32_t* cells,
           {
             if (held && constrained[J * bs + b])
               continue;
-            if (J != I)
+            if (off)
+              block[a * bs + b] += e[b];
+            else if (J != I)
               block[b * bs + a] += e[b];
             else if (b >= a)
             {
@@ -595,7 +618,8 @@ int64_t add_cells_upper(uintptr_t address, int64_t ncells, const int32_t* cells,
                         const int32_t* blocks, int64_t ng, const int32_t* geometry, const double* x,
                         const double* w, int64_t wstride, const double* c, const uint8_t* constrained,
                         int64_t bs, const int32_t* bi, const int32_t* bj, double* out, double* Ae, double* X,
-                        int32_t* map);
+                        int32_t* map, int64_t owned, const int64_t* global, const int32_t* oi,
+                        const int32_t* oj, double* out_o, double* ghost, const int64_t* ghost_slot);
 int64_t set_constrained_upper(int64_t nblocks, int64_t bs, const int32_t* bi, const int32_t* bj,
                               const uint8_t* constrained, double* out);
 int64_t aij_from_upper(int64_t nblocks, int64_t bs, const int32_t* bi, const int32_t* bj, const double* S,
@@ -786,12 +810,17 @@ class CellAssembler:
         return self._ghost_rows, self._ghost_columns, ghost
 
 
-    def assemble_upper(self, bi, bj, out) -> None:
+    def assemble_upper(self, bi, bj, out, off=None):
         """out (the values of an SBAIJ matrix of the nodal upper block pattern ``bi``, ``bj``,
         column-major blocks) = the form's tangent, one rank: the upper triangle of the matrix that
         :meth:`assemble` adds into the AIJ matrix, to the last bit, without the AIJ matrix (the node
-        pairs of a cell on or above the diagonal: 36 of the 64 blocks of a hexahedron). Raises
-        RuntimeError if the pattern lacks a block the form needs."""
+        pairs of a cell on or above the diagonal: 36 of the 64 blocks of a hexahedron). Several
+        ranks: ``off = (oi, oj, out_o, first)``, (bi, bj) the pattern of the owned block columns
+        (local indices) and (oi, oj) that of the higher ranks' columns (global block indices; out_o
+        its values, row-major blocks), ``first`` the first owned node's global index; the order of
+        a pair is that of its nodes' global indices, and the rows of ghost nodes are handed back
+        as :meth:`assemble` hands them back. Raises RuntimeError if the pattern lacks a block the
+        form needs."""
         module = compiled()
         ffi, lib = module.ffi, module.lib
 
@@ -810,8 +839,19 @@ class CellAssembler:
         if self.upper_maps is None:
             self.upper_maps = [np.full((len(cells), nb * nb), -1, dtype=np.int32) for _, cells, _ in self.integrals]
         out[:] = 0.0
+        null = ffi.NULL
+        ghost = np.zeros((len(self.ghost_cells), n * n)) if off is not None else np.zeros((0, 0))
+        if off is not None:
+            oi, oj, out_o, first = off
+            out_o[:] = 0.0
+            node_index = np.concatenate([np.arange(first, first + self.owned, dtype=np.int64), self.ghosts // self.bs])
+            split = (self.owned, ptr("int64_t", node_index), ptr("int32_t", oi),
+                     ptr("int32_t", oj) if len(oj) else null, ptr("double", out_o) if out_o.size else null,
+                     ptr("double", ghost) if ghost.size else null)
+        else:
+            split = (len(bi) - 1, null, null, null, null, null)
         missing = 0
-        for (address, cells, key), known in zip(self.integrals, self.upper_maps):
+        for (address, cells, key), known, slot in zip(self.integrals, self.upper_maps, self.slots):
             w = np.ascontiguousarray(packed[key], dtype=np.float64)
             if w.size == 0:
                 w = np.zeros((len(cells), 1))
@@ -820,11 +860,15 @@ class CellAssembler:
                                            ptr("double", w), w.shape[1] if w.size else 0, ptr("double", c),
                                            ptr("uint8_t", held), self.bs, ptr("int32_t", bi), ptr("int32_t", bj),
                                            ptr("double", out), ptr("double", Ae), ptr("double", X),
-                                           ptr("int32_t", known))
+                                           ptr("int32_t", known), *split,
+                                           ptr("int64_t", slot) if ghost.size else null)
         missing += lib.set_constrained_upper(len(bi) - 1, self.bs, ptr("int32_t", bi), ptr("int32_t", bj),
                                              ptr("uint8_t", held), ptr("double", out))
         if missing:
             raise RuntimeError(f"the SBAIJ pattern lacks {missing} blocks of the form")
+        if off is None:
+            return None
+        return self._ghost_rows, self._ghost_columns, ghost
 
 
 def aij_from_upper(bi, bj, S, bs: int, indptr, indices, values) -> None:

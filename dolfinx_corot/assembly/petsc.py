@@ -178,8 +178,10 @@ class SymmetricBlockOperator:
     nodal pattern, made once; :meth:`refresh` copies A's values whenever A has changed since
     (PETSc's object state): on one rank by a compiled loop from A's CSR arrays into S's
     (:func:`dolfinx_corot.assembly.cells.upper_blocks`; 8.6 M values in about 10 ms), where no
-    compiler is at hand by ``MatSetValues`` row by row (lower triangle ignored, 45 ms), on
-    several ranks by ``MatConvert`` into the same matrix (35 ms)."""
+    compiler is at hand by ``MatSetValues`` row by row (lower triangle ignored, 45 ms); on
+    several ranks the diagonal block by the same loop and the interface's blocks by
+    ``MatSetValuesBlocked`` (:meth:`_refresh_split`), without a compiler by ``MatConvert`` into
+    the same matrix (47 ms on two ranks)."""
 
     def __init__(self, A: PETSc.Mat):
         self.A = A
@@ -201,19 +203,26 @@ class SymmetricBlockOperator:
         self.S = S
         self._state = None
         self._compiled = None
+        self._split = None  # several ranks: S's diagonal block and the blocks of other ranks' columns
         # the tangent assembled straight into S (:meth:`assemble_upper`): A's values are made from
         # S only when something reads A (:meth:`sync`: the AMG's set-up, a fallback LU)
         self.upper_newer = False
         self.assembled = False  # whether a tangent was ever assembled into S alone
         self._diagonal = None
-        if self.serial:
-            from . import cells
+        from . import cells
 
-            try:
-                cells.compiled()
-                self._compiled = cells.upper_blocks
-            except Exception:  # no compiler: PETSc's insertion
-                pass
+        try:
+            cells.compiled()
+            compiled = True
+        except Exception:  # no compiler: PETSc's insertion, PETSc's conversion
+            compiled = False
+        if compiled and self.serial:
+            self._compiled = cells.upper_blocks
+        elif compiled and A.getType() == "mpiaij":
+            self._split = self._split_pattern(start // bs, stop // bs)
+            S.setLGMap(*A.getLGMap())  # the rows of ghost nodes go to their owners by local index
+            self._off_values = np.zeros((len(self._split[2]), bs * bs))
+            self._diagonal_vec = S.createVecLeft()
 
     @staticmethod
     def _upper_blocks(parts, bs: int, first_block: int, chunk: int = 4096):
@@ -248,30 +257,76 @@ class SymmetricBlockOperator:
         np.cumsum(counts, out=bi[1:])
         return bi, np.concatenate(columns) if columns else np.zeros(0, dtype=PETSc.IntType)
 
-    def _upper_values(self, action) -> None:
-        """action(values of S, (blocks × bs², column-major blocks)) on one rank; S's state changes."""
+    def _split_pattern(self, first_block: int, stop_block: int):
+        """Several ranks: S is PETSc's MPISBAIJ, its owned block rows split into the diagonal
+        block (a SeqSBAIJ matrix of the owned block columns, numbered from the first) and the
+        blocks of the columns of higher ranks. Returns the diagonal block's pattern (bi_d, bj_d,
+        local block columns), the global block rows and columns of the others ((k, 1) each) and,
+        for each of their bs² entries (row-major), its place in the values of A's off-diagonal
+        CSR block (-1: an entry A lacks, zero)."""
+        bs = self.bs
+        rows = np.repeat(np.arange(len(self.bi) - 1, dtype=np.int64), np.diff(self.bi))
+        cols = self.bj.astype(np.int64)
+        inside = cols < stop_block
+        bi_d = np.zeros(len(self.bi), dtype=PETSc.IntType)
+        np.cumsum(np.bincount(rows[inside], minlength=len(self.bi) - 1), out=bi_d[1:])
+        bj_d = (cols[inside] - first_block).astype(PETSc.IntType)
+        r_o, c_o = rows[~inside], cols[~inside]
+        with MPIAIJArrays(self.A, write=False) as (_, (ip, ix, _v), colmap):
+            colmap = np.asarray(colmap, dtype=np.int64)
+            i = np.arange(bs)
+            row = (r_o[:, None, None] * bs + i[None, :, None]) + 0 * i[None, None, :]  # (k, bs, bs)
+            gcol = (c_o[:, None, None] * bs + i[None, None, :]) + 0 * i[None, :, None]
+            local = np.searchsorted(colmap, gcol) if len(colmap) else np.zeros_like(gcol)
+            local = np.minimum(local, max(len(colmap) - 1, 0))
+            present = (colmap[local] == gcol) if len(colmap) else np.zeros(gcol.shape, dtype=bool)
+            # the off-diagonal CSR's entries as sorted keys row × n + local column
+            n = max(len(colmap), 1)
+            entry_rows = np.repeat(np.arange(len(ip) - 1, dtype=np.int64), np.diff(ip))
+            keys = entry_rows * n + ix.astype(np.int64)
+            order = np.argsort(keys, kind="stable")
+            want = row * n + local
+            at = np.minimum(np.searchsorted(keys[order], want), max(len(keys) - 1, 0))
+            found = present & (keys[order][at] == want) if len(keys) else np.zeros(want.shape, dtype=bool)
+            pos = np.where(found, order[at] if len(keys) else 0, -1).reshape(len(r_o), bs * bs)
+        R = (r_o + first_block).astype(PETSc.IntType).reshape(-1, 1)
+        C = c_o.astype(PETSc.IntType).reshape(-1, 1)
+        oi = np.zeros(len(self.bi), dtype=PETSc.IntType)
+        np.cumsum(np.bincount(r_o, minlength=len(self.bi) - 1), out=oi[1:])
+        return bi_d, bj_d, R, C, pos, oi, first_block
+
+    def _upper_values(self, action, handle=None, nblocks=None) -> None:
+        """action(values of S, (blocks × bs², column-major blocks)) on one rank (or of the SeqSBAIJ
+        matrix at ``handle`` with ``nblocks`` blocks); its state changes."""
         ctypes, lib, _, _ = _petsc_library()
-        handle, v = ctypes.c_void_p(self.S.handle), ctypes.POINTER(ctypes.c_double)()
+        handle = ctypes.c_void_p(self.S.handle if handle is None else handle)
+        v = ctypes.POINTER(ctypes.c_double)()
         if lib.MatSeqSBAIJGetArray(handle, ctypes.byref(v)):
             raise RuntimeError("MatSeqSBAIJGetArray failed")
         try:
-            action(np.ctypeslib.as_array(v, shape=(int(self.bi[-1]) * self.bs ** 2,)))
+            n = int(self.bi[-1]) if nblocks is None else nblocks
+            action(np.ctypeslib.as_array(v, shape=(n * self.bs ** 2,)) if n else np.zeros(0))
         finally:
             lib.MatSeqSBAIJRestoreArray(handle, ctypes.byref(v))
 
     @property
     def direct(self) -> bool:
-        """Whether a tangent can be assembled into S itself (one rank, the compiled loops)."""
-        return self._compiled is not None
+        """Whether a tangent can be assembled into S itself (the compiled loops)."""
+        return self._compiled is not None or self._split is not None
 
     def assemble_upper(self, assemble) -> None:
-        """S's values = ``assemble(values)`` (the tangent's upper block triangle, written in place:
-        :meth:`dolfinx_corot.assembly.cells.CellAssembler.assemble_upper`); A's values are now
-        out of date until :meth:`sync`. The diagonal is kept (:meth:`diagonal`)."""
+        """S = ``assemble(bi, bj, values, off)`` (the tangent's upper block triangle, written in
+        place: :meth:`dolfinx_corot.assembly.cells.CellAssembler.assemble_upper`); A's values are
+        now out of date until :meth:`sync`. The diagonal is kept (:meth:`diagonal`). Several
+        ranks: the owned block columns into S's diagonal block, the higher ranks' columns and the
+        rows of ghost nodes (handed back by ``assemble``) by ``MatSetValuesBlocked``."""
         bs = self.bs
+        if self._split is not None:
+            self._assemble_split(assemble)
+            return
 
         def action(values):
-            assemble(values)
+            assemble(self.bi, self.bj, values, None)
             self._diagonal = values.reshape(-1, bs * bs)[self.bi[:-1], :: bs + 1].ravel()
 
         self._upper_values(action)
@@ -285,10 +340,45 @@ class SymmetricBlockOperator:
             cells.set_diagonal(indptr, indices, a, self._diagonal)
         self._state = self.A.stateGet()
 
+    def _assemble_split(self, assemble) -> None:
+        from . import cells
+
+        bi_d, bj_d, R, C, _pos, oi, first = self._split
+        S, out_o, ghosts = self.S, self._off_values, []
+        S.zeroEntries()
+        self._upper_values(lambda values: ghosts.append(assemble(bi_d, bj_d, values, (oi, C.ravel(), out_o, first))),
+                           handle=S.getDiagonalBlock().handle, nblocks=int(bi_d[-1]))
+        if len(R):
+            S.setValuesBlockedRCV(R, C, out_o, addv=PETSc.InsertMode.ADD_VALUES)
+        rows, columns, ghost = ghosts[0]
+        if len(rows):  # lower blocks among them are dropped (IGNORE_LOWER_TRIANGULAR)
+            S.setValuesBlockedLocalRCV(rows, columns, ghost, addv=PETSc.InsertMode.ADD_VALUES)
+        S.assemble()
+        S.getDiagonal(self._diagonal_vec)
+        self._diagonal = self._diagonal_vec.array_r.copy()
+        self.upper_newer = True
+        self.assembled = True
+        with MPIAIJArrays(self.A, write=True) as ((indptr, indices, a), _off, _colmap):
+            cells.set_diagonal(indptr, indices, a, self._diagonal)
+        self.A.assemble()  # (its state changes: the smoothers read its diagonal)
+        self._state = self.A.stateGet()
+
     def sync(self) -> None:
         """A = S and its mirror image (A's pattern, lower triangle included), where S was assembled
-        after A; A's state changes, so that preconditioners set up from it anew."""
+        after A; A's state changes, so that preconditioners set up from it anew. Several ranks:
+        PETSc's conversion of a copy of S into a new AIJ matrix added into A (the AMG's set-up:
+        rare)."""
         if not self.upper_newer:
+            return
+        if self._split is not None:
+            # (of a copy: PETSc 3.18's conversion leaves the MPISBAIJ matrix it reads broken)
+            copy = self.S.duplicate(copy=True)
+            full = copy.convert("aij")
+            self.A.zeroEntries()
+            self.A.axpy(1.0, full, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+            destroy(full, copy)
+            self.upper_newer = False
+            self._state = self.A.stateGet()
             return
         from . import cells
 
@@ -330,13 +420,33 @@ class SymmetricBlockOperator:
             with SeqAIJArrays(self.A, write=False) as (indptr, indices, values):
                 S.setValuesCSR(indptr, indices, values)
             S.assemble()
+        elif self._split is not None:
+            self._refresh_split()
         else:
             self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.A.convert("sbaij", S)
         self._state = self.A.stateGet()
 
+    def _refresh_split(self) -> None:
+        """Several ranks: S's diagonal block copied from A's by the compiled loop, the few blocks
+        of higher ranks' columns (the interface's) inserted from A's off-diagonal block; no
+        communication (on the 116 k-dof block, 2 ranks: PETSc's MatConvert took 47 ms a copy)."""
+        from . import cells
+
+        bi_d, bj_d, R, C, pos, _oi, _first = self._split
+        Sd = self.S.getDiagonalBlock()
+        with MPIAIJArrays(self.A, write=False) as ((indptr, indices, values), (_ip, _ix, v), _colmap):
+            self._upper_values(lambda out: cells.upper_blocks(indptr, indices, values, self.bs, bi_d, bj_d, out),
+                               handle=Sd.handle, nblocks=int(bi_d[-1]))
+            V = np.where(pos >= 0, v[np.maximum(pos, 0)] if len(v) else 0.0, 0.0)
+        if len(R):
+            self.S.setValuesBlockedRCV(R, C, V, addv=PETSc.InsertMode.INSERT_VALUES)
+        self.S.assemble()
+
     def destroy(self) -> None:
         self.S.destroy()
+        if self._split is not None:
+            self._diagonal_vec.destroy()
 
 
 def coupling_matrix(comm, sizes, ownership: tuple[int, int], entries: np.ndarray) -> PETSc.Mat:

@@ -439,12 +439,11 @@ class System:
 
     def _upper_operator(self):
         """The iterative solver's symmetric block operator where the tangent is assembled into it
-        alone (one rank, the compiled assembly, CG on the upper block triangle; the solver has no
+        alone (the compiled assembly, CG on the upper block triangle; the solver has no
         contributions), else None. The AIJ matrix A is then filled from it only where it is read:
         the AMG's set-up (once on the SVK block of benchmarks/block3d.py, whose hierarchy is kept
         and co-rotated), a fallback LU, the stability checks (:attr:`A`)."""
-        if (self._cells is None or self.comm.size > 1 or not self.iterative or self.contributions
-                or not self._upper_assembly):
+        if self._cells is None or not self.iterative or self.contributions or not self._upper_assembly:
             return None
         operator = self.linear.block_operator()
         return operator if operator is not None and operator.direct else None
@@ -453,7 +452,7 @@ class System:
         if self._cells is not None:
             operator = self._upper_operator()
             if operator is not None:
-                operator.assemble_upper(lambda out: self._cells.assemble_upper(operator.bi, operator.bj, out))
+                operator.assemble_upper(self._cells.assemble_upper)
                 return
             if self.comm.size == 1:
                 with petsc.SeqAIJArrays(self._A) as (indptr, indices, values):

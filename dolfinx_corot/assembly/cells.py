@@ -23,11 +23,13 @@ them, so that the matrix is again DOLFINx's to the last bit.
 
 The same library copies a symmetric AIJ matrix's upper triangle into an SBAIJ matrix of its
 nodal blocks (:func:`upper_blocks`; the operator of the iterative solver,
-:class:`~dolfinx_corot.assembly.petsc.SymmetricBlockOperator`). On one rank the tangent can go
-into that SBAIJ matrix alone (:meth:`CellAssembler.assemble_upper`: the node pairs of a cell on or
-above the diagonal, 36 of a hexahedron's 64 blocks, the same sums in the same order as the copy's),
-the AIJ matrix being made from it (:func:`aij_from_upper`, the mirror image) only where it is
-read: the AMG's set-up, a fallback LU, the stability checks. The library also holds the loops of the
+:class:`~dolfinx_corot.assembly.petsc.SymmetricBlockOperator`). The tangent can go into that
+SBAIJ matrix alone (:meth:`CellAssembler.assemble_upper`: the node pairs of a cell on or above the
+diagonal, 36 of a hexahedron's 64 blocks; on one rank the same sums in the same order as the
+copy's; on several the owned nodes' rows, the pairs ordered by global node index, into the
+diagonal block of PETSc's MPISBAIJ matrix and the blocks of higher ranks' columns, the rows of
+ghost nodes handed back whole), the AIJ matrix being made from it (:func:`aij_from_upper`, the
+mirror image) only where it is read: the AMG's set-up, a fallback LU, the stability checks. The library also holds the loops of the
 co-rotated AMG hierarchy (:mod:`dolfinx_corot.assembly.amg`: the patches' moments
 ``patch_moments``, their rotations ``polar3``, the check ``unlike_rows`` and the rotation
 ``rotate_rows`` of a prolongator's nodal rows).

@@ -354,7 +354,7 @@ def test_compiled_assembly_is_dolfinx_assembly_bit_for_bit(monkeypatch, cell, de
     sc = _deformed_block(cell, degree, material)
     system = make_system(sc.model, solver="direct")
     model = sc.model
-    system.jacobian()  # DOLFINx's: lays out the pattern
+    system.jacobian()  # the compiled loop's first (the pattern laid out from the form's)
     assert system._cells is not None
     if comm.size > 1:  # the ranks share nodes: some element matrices have rows of ghost nodes
         assert comm.allreduce(len(system._cells.ghost_cells), op=MPI.MIN) > 0
@@ -391,6 +391,30 @@ def test_compiled_assembly_is_dolfinx_assembly_bit_for_bit(monkeypatch, cell, de
         assert np.array_equal(system.A.getValuesCSR()[2], fast)
         system._cells = saved
     system.destroy()
+
+
+@pytest.mark.parametrize("cell, degree", [("hexahedron", 1), ("tetrahedron", 2)], ids=["hex-Q1", "tet-P2"])
+def test_the_first_tangent_needs_no_dolfinx_assembly(monkeypatch, cell, degree):
+    """Where the compiled loop assembles the tangent, A's pattern is laid out from the form's
+    sparsity pattern (``_dolfinx.form_pattern``) and the loop assembles the first tangent too:
+    pattern and values are those of DOLFINx's first assembly to the last bit, supports included."""
+    from dolfinx_corot.assembly import cells
+
+    monkeypatch.setattr(cells, "MIN_CELLS", 0)
+    csr = []
+    for dolfinx_first in (False, True):
+        sc = _deformed_block(cell, degree, dc.SaintVenantKirchhoff(1e5, 0.3))
+        system = make_system(sc.model, solver="direct")
+        _move_to(system, sc.model, 0.01 * np.random.default_rng(2).normal(size=sc.model.state.x.array.size))
+        if dolfinx_first:
+            system._cells_checked = True  # DOLFINx's assembly, as before the pattern was laid out
+        system.residual(0.5)
+        system.jacobian()
+        assert (system._cells is None) == dolfinx_first
+        csr.append([a.copy() for a in system.A.getValuesCSR()])
+        system.destroy()
+    for ours, theirs in zip(*csr):
+        assert np.array_equal(ours, theirs)
 
 
 @pytest.mark.parametrize("n, degree", [((6, 2, 2), 1), ((3, 1, 1), 2), ((6, 3), 2)],
@@ -485,8 +509,9 @@ def test_the_tangent_assembled_into_its_upper_block_triangle_alone_is_the_copied
         sc.fix(b, "right", dofs=("uy",))
         sc.load(b, "right", traction=(1.0, 0.0))
     system = make_system(sc.model, solver="iterative")
-    system.jacobian()  # DOLFINx's: lays out the pattern
-    assert system._cells is not None
+    system.jacobian()  # the first tangent: into A
+    assert system._cells is not None and system._upper_operator() is None
+    system.linear.block_operator()  # made by the first solve, from A's pattern
     rng = np.random.default_rng(5)
     _move_to(system, sc.model, 0.01 * rng.normal(size=sc.model.state.x.array.size))
     system.residual(0.5)

@@ -741,6 +741,7 @@ class CellAssembler:
         # their rows and columns for MatSetValuesBlockedLocal: the rows of owned nodes left out (−1)
         self._ghost_columns = self.blocks[self.ghost_cells]
         self._ghost_rows = np.where(self._ghost_columns < self.owned, -1, self._ghost_columns).astype(np.int32)
+        self._calls = 0  # calls of assemble
         self.maps = None  # per integral: where each pair of a cell's nodes has its block in the rows
         self.upper_maps = None  # the same in the block rows of the upper triangle (assemble_upper)
 
@@ -789,9 +790,14 @@ class CellAssembler:
         else:
             off_args = (null, null, null, null)
         missing = 0
-        if self.maps is None:  # the places of the nodal blocks in their rows, found by the first call
+        # the places of the nodal blocks in their rows, kept from the second call on (where the
+        # upper triangle alone is assembled after a first tangent into A, they would take 4 bytes
+        # a node pair beside the upper triangle's own)
+        self._calls += 1
+        if self.maps is None and self._calls > 1:
             self.maps = [np.full((len(cells), nb * nb), -1, dtype=np.int32) for _, cells, _ in self.integrals]
-        for (address, cells, key), slot, known in zip(self.integrals, self.slots, self.maps):
+        maps = self.maps if self.maps is not None else [None] * len(self.integrals)
+        for (address, cells, key), slot, known in zip(self.integrals, self.slots, maps):
             w = np.ascontiguousarray(packed[key], dtype=np.float64)
             if w.size == 0:
                 w = np.zeros((len(cells), 1))
@@ -802,7 +808,7 @@ class CellAssembler:
                                      ptr("uint8_t", held), self.bs, ptr("double", ghost) if ghost.size else null,
                                      ptr("int64_t", slot) if len(self.ghost_cells) else null,
                                      ptr("double", Ae), ptr("double", X), ptr("int64_t", place),
-                                     ptr("int32_t", known))
+                                     null if known is None else ptr("int32_t", known))
         missing += lib.set_constrained_diagonal(len(indptr) - 1, ptr("int32_t", indptr), ptr("int32_t", indices),
                                                 ptr("uint8_t", held), ptr("double", values))
         if missing:

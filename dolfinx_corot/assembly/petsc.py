@@ -449,6 +449,13 @@ class SymmetricBlockOperator:
             self._diagonal_vec.destroy()
 
 
+def lay_out(A: PETSc.Mat, indptr: np.ndarray, indices: np.ndarray) -> None:
+    """A (made, not yet assembled) gets the pattern (indptr, global columns) of its owned rows, its
+    values zero, and is assembled; a new entry is an error afterwards."""
+    A.setPreallocationCSR((indptr.astype(PETSc.IntType), indices.astype(PETSc.IntType)))
+    A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
+
+
 def coupling_matrix(comm, sizes, ownership: tuple[int, int], entries: np.ndarray) -> PETSc.Mat:
     """AIJ matrix of the given (global row, global column) entries ((k, 2), gathered on every rank),
     laid out like a matrix of ``sizes``; inserting outside the pattern is an error."""

@@ -8,8 +8,8 @@
   :func:`petsc_vector`: a global numbering and a matrix over several meshes
   (parts stacked by :class:`dolfinx_corot.assembly.layout.DofLayout`); only
   :mod:`dolfinx_corot.assembly.petsc` calls the two PETSc factories.
-* :func:`form_pattern`: the CSR pattern DOLFINx lays out for a form's matrix, from its sparsity
-  pattern (so that a matrix's pattern can be made without DOLFINx's first assembly).
+* :func:`form_sparsity`: the nodal block pattern DOLFINx lays out a form's matrix from (so that
+  the matrix's pattern can be made without DOLFINx's first assembly).
 * :func:`assemble_matrix_into`: a form's matrix added to an existing PETSc
   matrix through its current local-to-global map (no Dirichlet rows).
 * :func:`assemble_vector_into`, :func:`assemble_matrix_with_bcs`: DOLFINx's own assembly into
@@ -84,10 +84,10 @@ def sparsity_pattern(comm, imap, blocks: Sequence[np.ndarray], n_owned: int):
     return sp
 
 
-def form_pattern(form, bs: int, chunk: int = 512):
-    """The CSR pattern of the owned rows of the matrix DOLFINx makes for the bilinear ``form`` (one
-    space of nodal blocks of ``bs`` dofs), as ``dolfinx.fem.petsc.create_matrix`` lays it out:
-    (indptr, global columns, sorted in each row), both int32; ``chunk`` block rows at a time."""
+def form_sparsity(form):
+    """The nodal block pattern of the owned rows of the matrix DOLFINx makes for the bilinear
+    ``form`` (``dolfinx.fem.petsc.create_matrix`` lays it out from the same): (offsets, local block
+    columns, their global indices) of its block rows."""
     spaces = form.function_spaces
     sp = dolfinx.cpp.fem.create_sparsity_pattern(form.mesh.topology, [spaces[0].dofmap, spaces[1].dofmap],
                                                  form.integral_types)
@@ -95,27 +95,10 @@ def form_pattern(form, bs: int, chunk: int = 512):
     n = sp.index_map(0).size_local
     columns = sp.column_index_map()
     offsets = np.asarray(sp.graph.offsets, dtype=np.int64)[: n + 1]
-    links = np.asarray(sp.graph.array)[: offsets[-1]]
+    links = np.asarray(sp.graph.array[: offsets[-1]], dtype=np.int32)
     to_global = np.asarray(columns.local_to_global(np.arange(columns.size_local + columns.num_ghosts, dtype=np.int32)),
                            dtype=np.int64)
-    count = np.diff(offsets)
-    indptr = np.zeros(n * bs + 1, dtype=np.int64)
-    np.cumsum(np.repeat(count * bs, bs), out=indptr[1:])
-    indices = np.empty(int(indptr[-1]), dtype=np.int32)
-    lanes = np.arange(bs, dtype=np.int64)
-    for lo in range(0, n, chunk):
-        hi = min(lo + chunk, n)
-        rows = np.repeat(np.arange(lo, hi, dtype=np.int64), count[lo:hi])
-        g = to_global[links[offsets[lo]:offsets[hi]]]
-        order = np.lexsort((g, rows))  # (owned and ghost columns are not in global order on several ranks)
-        g = g[order]
-        expanded = (g[:, None] * bs + lanes).ravel()  # each block row's columns, unrolled
-        start = (offsets[lo:hi] - offsets[lo]) * bs
-        length = count[lo:hi] * bs
-        first, last = np.repeat(start, bs), np.repeat(length, bs)
-        at = np.repeat(first - np.cumsum(last) + last, last) + np.arange(int(last.sum()), dtype=np.int64)
-        indices[indptr[lo * bs]:indptr[hi * bs]] = expanded[at]
-    return indptr.astype(np.int32), indices
+    return offsets, links, to_global
 
 
 def petsc_matrix(comm, pattern):

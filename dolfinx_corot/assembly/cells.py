@@ -382,6 +382,39 @@ void diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, cons
   }
 }
 
+/* The scalar CSR (indptr, indices: global columns, sorted in each row) of the n block rows of a
+   nodal block pattern with blocks of bs: block row r couples the local block columns
+   links[offsets[r]] ... links[offsets[r + 1] - 1], whose global indices are to_global[link]; every
+   row of a block row has the same columns. work: the longest block row's length. */
+void expand_blocks(int64_t n, int64_t bs, const int64_t* offsets, const int32_t* links, const int64_t* to_global,
+                   int32_t* indptr, int32_t* indices, int64_t* work)
+{
+  int64_t p = 0;
+  indptr[0] = 0;
+  for (int64_t r = 0; r < n; ++r)
+  {
+    const int64_t count = offsets[r + 1] - offsets[r];
+    for (int64_t k = 0; k < count; ++k)
+    {
+      const int64_t g = to_global[links[offsets[r] + k]];
+      int64_t i = k;
+      while (i > 0 && work[i - 1] > g)
+      {
+        work[i] = work[i - 1];
+        --i;
+      }
+      work[i] = g;
+    }
+    for (int64_t a = 0; a < bs; ++a)
+    {
+      for (int64_t k = 0; k < count; ++k)
+        for (int64_t b = 0; b < bs; ++b)
+          indices[p++] = (int32_t)(work[k] * bs + b);
+      indptr[r * bs + a + 1] = (int32_t)p;
+    }
+  }
+}
+
 /* values' diagonal entries = diag (rows that lack one: counted) */
 int64_t set_diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, const double* diag,
                      double* values)
@@ -630,6 +663,8 @@ int64_t set_constrained_diagonal(int64_t nrows, const int32_t* indptr, const int
                                  const uint8_t* constrained, double* values);
 int64_t set_diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, const double* diag,
                      double* values);
+void expand_blocks(int64_t n, int64_t bs, const int64_t* offsets, const int32_t* links, const int64_t* to_global,
+                   int32_t* indptr, int32_t* indices, int64_t* work);
 void diagonal(int64_t nrows, const int32_t* indptr, const int32_t* indices, const double* values, double* out);
 int64_t upper_blocks(int64_t nblocks, int64_t bs, const int32_t* indptr, const int32_t* indices,
                      const double* values, const int32_t* bi, const int32_t* bj, double* out);
@@ -907,6 +942,27 @@ def diagonal(indptr, indices, values) -> np.ndarray:
         lib.diagonal(len(out), ffi.cast("int32_t*", indptr.ctypes.data), ffi.cast("int32_t*", indices.ctypes.data),
                      ffi.cast("double*", values.ctypes.data), ffi.cast("double*", out.ctypes.data))
     return out
+
+
+def expand_blocks(offsets, links, to_global, bs: int):
+    """(indptr, indices) int32: the scalar CSR of the owned rows of a nodal block pattern (block
+    row r couples the local block columns links[offsets[r]:offsets[r + 1]], their global indices
+    to_global), global columns sorted in each row (:c:func:`expand_blocks`)."""
+    module = compiled()
+    ffi, lib = module.ffi, module.lib
+    offsets = np.ascontiguousarray(offsets, dtype=np.int64)
+    links = np.ascontiguousarray(links, dtype=np.int32)
+    to_global = np.ascontiguousarray(to_global, dtype=np.int64)
+    n = len(offsets) - 1
+    count = np.diff(offsets)
+    indptr = np.empty(n * bs + 1, dtype=np.int32)
+    indices = np.empty(int(offsets[-1]) * bs * bs, dtype=np.int32)
+    work = np.empty(max(int(count.max(initial=0)), 1), dtype=np.int64)
+    lib.expand_blocks(n, bs, ffi.cast("int64_t*", offsets.ctypes.data), ffi.cast("int32_t*", links.ctypes.data),
+                      ffi.cast("int64_t*", to_global.ctypes.data), ffi.cast("int32_t*", indptr.ctypes.data),
+                      ffi.cast("int32_t*", indices.ctypes.data if indices.size else work.ctypes.data),
+                      ffi.cast("int64_t*", work.ctypes.data))
+    return indptr, indices
 
 
 def set_diagonal(indptr, indices, values, diag) -> None:

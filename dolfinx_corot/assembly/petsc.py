@@ -59,7 +59,8 @@ def copy(v: PETSc.Vec) -> PETSc.Vec:
 def _petsc_library():
     """(ctypes, the PETSc library petsc4py is linked to, PetscInt*, PetscInt) with the argument
     types of the calls petsc4py 3.18 lacks: ``MatGetRowIJ``, ``MatSeqAIJGetArray[Read]``,
-    ``MatSeqSBAIJGetArray``, ``MatMPIAIJGetSeqAIJ``, ``MatGetSize`` and their Restore calls."""
+    ``MatSeqSBAIJGetArray``, ``MatMPIAIJGetSeqAIJ``, ``MatGetSize``, ``MatSeqAIJSetColumnIndices``
+    and their Restore calls."""
     global _LIBRARY
     if _LIBRARY is None:
         import ctypes
@@ -84,6 +85,8 @@ def _petsc_library():
         lib.MatMPIAIJGetSeqAIJ.restype = ctypes.c_int
         lib.MatGetSize.argtypes = [ctypes.c_void_p, p_int, p_int]
         lib.MatGetSize.restype = ctypes.c_int
+        lib.MatSeqAIJSetColumnIndices.argtypes = [ctypes.c_void_p, p_int]
+        lib.MatSeqAIJSetColumnIndices.restype = ctypes.c_int
         _LIBRARY = (ctypes, lib, p_int, int_t)
     return _LIBRARY
 
@@ -450,9 +453,20 @@ class SymmetricBlockOperator:
 
 
 def lay_out(A: PETSc.Mat, indptr: np.ndarray, indices: np.ndarray) -> None:
-    """A (made, not yet assembled) gets the pattern (indptr, global columns) of its owned rows, its
-    values zero, and is assembled; a new entry is an error afterwards."""
-    A.setPreallocationCSR((indptr.astype(PETSc.IntType), indices.astype(PETSc.IntType)))
+    """A (made and preallocated, not yet assembled) gets the pattern (indptr, global columns) of its
+    owned rows, its values zero, and is assembled; a new entry is an error afterwards. One rank,
+    where A's preallocation is the pattern's to the entry: its column indices written in place
+    (``MatSeqAIJSetColumnIndices``), else PETSc's insertion row by row."""
+    if (A.getType() == "seqaij" and np.dtype(PETSc.IntType) == np.int32
+            and int(A.getInfo()["nz_allocated"]) == int(indptr[-1])):
+        ctypes, lib, p_int, _ = _petsc_library()
+        indices = np.ascontiguousarray(indices, dtype=np.int32)
+        if lib.MatSeqAIJSetColumnIndices(ctypes.c_void_p(A.handle), indices.ctypes.data_as(p_int)):
+            raise RuntimeError("MatSeqAIJSetColumnIndices failed")
+        A.assemble()
+        A.zeroEntries()
+    else:
+        A.setPreallocationCSR((indptr.astype(PETSc.IntType), indices.astype(PETSc.IntType)))
     A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
 
 

@@ -475,7 +475,9 @@ class System:
             if self._cells is not None:
                 # A's pattern laid out from the form's sparsity, so that the compiled loop assembles
                 # the first tangent too (DOLFINx's insertion of it took 0.3–0.4 s on the 116 k-dof block)
-                petsc.lay_out(self._A, *_dolfinx.form_pattern(self.a, self._A.getBlockSize()))
+                from . import cells
+
+                petsc.lay_out(self._A, *cells.expand_blocks(*_dolfinx.form_sparsity(self.a), self._A.getBlockSize()))
                 self._assemble_parts_matrix()
                 return
         self._A.zeroEntries()

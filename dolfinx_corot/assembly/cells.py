@@ -777,6 +777,7 @@ class CellAssembler:
         self._ghost_columns = self.blocks[self.ghost_cells]
         self._ghost_rows = np.where(self._ghost_columns < self.owned, -1, self._ghost_columns).astype(np.int32)
         self._calls = 0  # calls of assemble
+        self._node_index = None  # several ranks: each local node's global index (assemble_upper)
         self.maps = None  # per integral: where each pair of a cell's nodes has its block in the rows
         self.upper_maps = None  # the same in the block rows of the upper triangle (assemble_upper)
 
@@ -887,8 +888,10 @@ class CellAssembler:
         if off is not None:
             oi, oj, out_o, first = off
             out_o[:] = 0.0
-            node_index = np.concatenate([np.arange(first, first + self.owned, dtype=np.int64), self.ghosts // self.bs])
-            split = (self.owned, ptr("int64_t", node_index), ptr("int32_t", oi),
+            if self._node_index is None or self._node_index[0] != first:  # each local node's global index
+                self._node_index = np.concatenate([np.arange(first, first + self.owned, dtype=np.int64),
+                                                   self.ghosts // self.bs])
+            split = (self.owned, ptr("int64_t", self._node_index), ptr("int32_t", oi),
                      ptr("int32_t", oj) if len(oj) else null, ptr("double", out_o) if out_o.size else null,
                      ptr("double", ghost) if ghost.size else null)
         else:

@@ -15,6 +15,7 @@ import logging
 from typing import Sequence
 
 import numpy as np
+from mpi4py import MPI
 from petsc4py import PETSc
 
 import dolfinx.fem.petsc
@@ -219,6 +220,8 @@ class SymmetricBlockOperator:
             compiled = True
         except Exception:  # no compiler: PETSc's insertion, PETSc's conversion
             compiled = False
+        if A.comm.size > 1:  # the same choice on every rank (their calls are collective)
+            compiled = bool(A.comm.tompi4py().allreduce(int(compiled), op=MPI.MIN))
         if compiled and self.serial:
             self._compiled = cells.upper_blocks
         elif compiled and A.getType() == "mpiaij":
@@ -278,8 +281,9 @@ class SymmetricBlockOperator:
         with MPIAIJArrays(self.A, write=False) as (_, (ip, ix, _v), colmap):
             colmap = np.asarray(colmap, dtype=np.int64)
             i = np.arange(bs)
-            row = (r_o[:, None, None] * bs + i[None, :, None]) + 0 * i[None, None, :]  # (k, bs, bs)
-            gcol = (c_o[:, None, None] * bs + i[None, None, :]) + 0 * i[None, :, None]
+            shape = (len(r_o), bs, bs)  # entry (a, b) of each block: row r·bs + a, column c·bs + b
+            row = np.broadcast_to(r_o[:, None, None] * bs + i[None, :, None], shape)
+            gcol = np.broadcast_to(c_o[:, None, None] * bs + i[None, None, :], shape)
             local = np.searchsorted(colmap, gcol) if len(colmap) else np.zeros_like(gcol)
             local = np.minimum(local, max(len(colmap) - 1, 0))
             present = (colmap[local] == gcol) if len(colmap) else np.zeros(gcol.shape, dtype=bool)

@@ -474,7 +474,7 @@ class System:
             self._cells = self._cell_assembler()
             if self._cells is not None:
                 # A's pattern laid out from the form's sparsity, so that the compiled loop assembles
-                # the first tangent too (DOLFINx's insertion of it took 0.3–0.4 s on the 116 k-dof block)
+                # the first tangent too (DOLFINx's insertion of it took 0.4–0.8 s on the 116 k-dof block, this 0.2 s)
                 from . import cells
 
                 petsc.lay_out(self._A, *cells.expand_blocks(*_dolfinx.form_sparsity(self.a), self._A.getBlockSize()))

@@ -4,7 +4,10 @@ Each command runs as a fresh process, the commands taking turns (``--repeats`` r
 the machine's load falls on all of them alike; the median wall time and the peak resident memory
 of each are reported:
 
-* ``import dolfinx`` — the floor every DOLFINx script pays;
+* ``import dolfinx`` — the floor every DOLFINx script pays, with Open MPI's defaults;
+* ``import dolfinx, singleton MPI`` — the same with the settings the package makes for a process
+  started without mpirun (``dolfinx_corot.SINGLETON_MPI``: no local daemon, the ob1 layer), when
+  it is imported before MPI starts;
 * ``import dolfinx_corot`` — the package itself (it imports its names on first use);
 * ``dolfinx_corot.Scene`` — what a script pays before its first scene: DOLFINx and our modules;
 * the 45° bend (Bathe & Bolourchi 1979; 8 co-rotational 3D beams from arrays, 20 load steps to
@@ -56,6 +59,9 @@ print("BEND", first, again, result.totals["newton_iterations"], row["tip_ux"], r
 
 COMMANDS = {
     "import dolfinx": "import dolfinx",
+    # (written out: importing the package here would hand its settings to every child)
+    "import dolfinx, singleton MPI": "import os; os.environ.update({'OMPI_MCA_ess_singleton_isolated': '1', "
+                                     "'OMPI_MCA_pml': 'ob1'}); import dolfinx",
     "import dolfinx_corot": "import dolfinx_corot",
     "dolfinx_corot.Scene": "import dolfinx_corot; dolfinx_corot.Scene",
     "45° bend, 8 beams, 20 steps": "AGAIN = False\n" + BEND,

@@ -1,0 +1,52 @@
+"""Start-up: Open MPI's settings for a process started without a launcher
+(``dolfinx_corot.SINGLETON_MPI``, docs/performance.md "Start-up and a small model")."""
+import os
+import subprocess
+import sys
+
+import pytest
+from mpi4py import MPI
+
+import dolfinx_corot as dc
+
+serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="runs subprocesses; serial only")
+
+
+def test_a_singleton_gets_the_settings_a_launched_rank_or_a_users_setting_does_not_change():
+    env = {"PATH": "/usr/bin"}
+    assert dc._singleton_mpi(env) == dc.SINGLETON_MPI
+    assert all(env[k] == v for k, v in dc.SINGLETON_MPI.items())
+    for launcher in dc.LAUNCHED_BY:  # mpirun, PMIx, PMI, Slurm
+        env = {launcher: "0"}
+        assert dc._singleton_mpi(env) == {} and set(env) == {launcher}
+    env = {"OMPI_MCA_pml": "ucx"}  # the user's choice wins, the other setting is still made
+    assert dc._singleton_mpi(env) == {"OMPI_MCA_ess_singleton_isolated": "1"}
+    assert env["OMPI_MCA_pml"] == "ucx"
+
+
+def _fresh(code: str, **extra) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_MCA_", "PMIX_", "PMI_", "SLURM_"))
+           and k != "OMPI_COMM_WORLD_SIZE"}
+    env.update(extra)
+    return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+
+
+@serial
+def test_a_fresh_process_that_imports_the_package_first_runs_mpi_and_petsc_as_an_isolated_singleton():
+    """The settings take effect when the package is imported before MPI starts: MPI runs with one
+    rank, PETSc works, and nothing is written to stderr."""
+    out = _fresh("import os, dolfinx_corot\n"
+                 "from mpi4py import MPI\n"
+                 "import dolfinx\n"
+                 "from petsc4py import PETSc\n"
+                 "v = PETSc.Vec().createMPI(4, comm=MPI.COMM_WORLD); v.set(2.0)\n"
+                 "print(MPI.COMM_WORLD.size, v.sum(), os.environ['OMPI_MCA_pml'],"
+                 " os.environ['OMPI_MCA_ess_singleton_isolated'])")
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["1", "8.0", "ob1", "1"]
+    assert out.stderr == ""
+    # a setting of the user's is kept
+    out = _fresh("import os, dolfinx_corot\nfrom mpi4py import MPI\nprint(os.environ['OMPI_MCA_pml'])",
+                 OMPI_MCA_pml="ob1,cm")
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["ob1,cm"]

@@ -682,11 +682,15 @@ class LinearSolver:
             A.setNearNullSpace(nullspace)
             # a tolerance given as a PETSc option is kept
             self._fixed_rtol = PETSc.Options().hasName(options_prefix + "ksp_rtol") or fixed_rtol
+            # CG measures the true residual under a forcing term (set_forcing)
+            self._forcing_norm = (symmetric and not options.hasName(options_prefix + "ksp_norm_type")
+                                  and options.getBool(options_prefix + "forcing_true_residual", True))
         else:
             self.ksp.setType("preonly")
             pc.setType("cholesky" if symmetric else "lu")
             pc.setFactorSolverType("mumps")
             self._fixed_rtol = True
+            self._forcing_norm = False
         self.ksp.setFromOptions()
         self.ksp.setOperators(A)
         # CG reads the tangent's upper triangle in nodal blocks; AMG is built from A itself
@@ -812,9 +816,23 @@ class LinearSolver:
 
     def set_forcing(self, eta: float | None) -> None:
         """Relative tolerance of the next iterative solves (inexact Newton; None: back to 1e-10);
-        ignored by direct solvers and when ``-<prefix>ksp_rtol`` was given."""
+        ignored by direct solvers and when ``-<prefix>ksp_rtol`` was given.
+
+        Under a forcing term CG measures the true residual ‖b − Kx‖ (the unpreconditioned
+        norm), the one the forcing term bounds (Eisenstat & Walker 1996: ‖F + J s‖ ≤ η‖F‖).
+        With PETSc's default, the preconditioned norm ‖M⁻¹(b − Kx)‖, what η bought depended on
+        the preconditioner: Newton's residual on the 116 k-dof block fell by about 3·10⁻³ an
+        iteration whatever η asked, and by less on two ranks, whose AMG differs (25 Newton
+        iterations serially, 27 on two ranks; with the true residual and NewtonOptions' looser
+        tolerances it allows, 21 on both, docs/performance.md).
+        Without a forcing term (a linear solve to 1e-10) the preconditioned norm is kept: the
+        true residual of an ill-conditioned tangent stalls near round-off. ``-<prefix>forcing_true_residual
+        false``: the preconditioned norm throughout; a ``-<prefix>ksp_norm_type`` given is kept."""
         if self.iterative and not self._fixed_rtol:
             self.ksp.setTolerances(rtol=1e-10 if eta is None else eta)
+            if self._forcing_norm and self.ksp.getType() == "cg":
+                self.ksp.setNormType(PETSc.KSP.NormType.PRECONDITIONED if eta is None
+                                     else PETSc.KSP.NormType.UNPRECONDITIONED)
 
     def set_near_nullspace(self, nullspace: PETSc.NullSpace) -> None:
         """AMG's near-nullspace from the next preconditioner on. GAMG keeps the modes of its

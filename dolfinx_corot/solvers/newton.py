@@ -65,7 +65,8 @@ class NewtonOptions:
     forcing: inexact Newton for iterative linear solvers (Eisenstat & Walker 1996, choice 2):
     the first solve of a step to ``forcing_initial``, then to
     η_k = γ (‖r_k‖/‖r_{k−1}‖)², kept below ``forcing_max`` and not below what the
-    final tolerance needs; direct solvers ignore it;
+    final tolerance needs, on the linear solve's true residual ‖b − Kx‖ (CG); direct
+    solvers ignore it;
     preconditioner: 'step' builds the iterative solver's preconditioner (AMG) from the first
     tangent of each step and keeps it for the step's later iterations, 'iteration' rebuilds it
     every iteration;
@@ -82,8 +83,8 @@ class NewtonOptions:
     line_search_tolerance: float = 0.5
     max_growth: int = 3
     forcing: bool = True
-    forcing_initial: float = 1e-3
-    forcing_max: float = 1e-2
+    forcing_initial: float = 1e-2
+    forcing_max: float = 1e-1
     forcing_gamma: float = 0.9
     preconditioner: str = "step"
     max_displacement: float = 1e3

@@ -28,14 +28,11 @@ import argparse
 import json
 import os
 import sys
-import time
 
 import numpy as np
 from mpi4py import MPI
 
-import dolfinx_corot as dc
 from dolfinx_corot.io import output_dir, write_rows
-from dolfinx_corot.io.gmsh_models import cylinder_eighth
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "demos"))
 import cylinder_pullout as demo  # noqa: E402  (the demo's geometry, material and measures)
@@ -45,39 +42,11 @@ FAMILIES = {"opt": "triangles (OPT + DKT)", "qm6": "quadrilaterals (DKQ)"}
 
 
 def path(n_theta, n_x, membrane, dw, w_max=2.6):
-    """(P, w_A) along the driven path, the wall time and the Newton iterations."""
-    scene = dc.Scene(large_rotations=True)
-    shell = scene.add_shell(cylinder_eighth(demo.R, demo.L, n_theta, n_x, comm=comm, quads=membrane == "qm6"),
-                            "shell", thickness=demo.t, material=dc.Elastic(demo.E, demo.nu), membrane=membrane)
-    scene.fix(shell, "mid", dofs=("ux", "ry", "rz"))
-    scene.fix(shell, "top", dofs=("uy", "rx", "rz"))
-    scene.fix(shell, "side", dofs=("uz", "rx", "ry"))
-    scene.prescribe(shell, "A", uz=w_max)
-    scene.monitor_reaction("A", shell, "A")
-    scene.monitor("A", shell, "A")
+    """(P, w_A) along the driven path (the demo's scene, driven to ``w_max``), the wall time and
+    the Newton iterations."""
     steps = np.r_[np.arange(1, 24) * 0.1, np.arange(2.3 + dw, w_max + 0.5 * dw, dw)]
-    t0 = time.perf_counter()
-    res = dc.solve(scene, dc.LoadControl(load_factors=steps / w_max), quiet=True)
-    wall = time.perf_counter() - t0
-    h = res.history
-    return 4.0 * h.column("A_Fz"), h.column("A_uz"), wall, res.totals["newton_iterations"]
-
-
-def snap(P, w):
-    """(number of local maxima, P_max, w_A there, fall to the valley after it relative to P_max,
-    least slope dP/dw_A over 2.45–2.55); without a maximum P_max and w_A are where it is flattest."""
-    P, w = np.r_[0.0, P], np.r_[0.0, w]
-    peaks = np.flatnonzero((P[1:-1] > P[:-2]) & (P[1:-1] >= P[2:])) + 1
-    slope = np.diff(P) / np.diff(w)
-    window = np.flatnonzero(np.abs(w[:-1] - demo.SNAP) <= 0.05)
-    least = float(slope[window].min())
-    if len(peaks) == 0:
-        k = window[np.argmin(slope[window])]
-        return 0, 0.5 * (P[k] + P[k + 1]), 0.5 * (w[k] + w[k + 1]), 0.0, least
-    k = max(peaks, key=lambda i: P[i])
-    rise = np.flatnonzero(np.diff(P[k:]) > 0.0)
-    valley = P[k + rise[0]] if len(rise) else P[-1]
-    return len(peaks), float(P[k]), float(w[k]), float((P[k] - valley) / P[k]), least
+    curve, res, wall = demo.pullout(n_theta, n_x, w_max=w_max, membrane=membrane, w_steps=steps)
+    return curve, wall, res.totals["newton_iterations"]
 
 
 def main():
@@ -90,12 +59,13 @@ def main():
     rows, curves = [], {}
     for membrane in FAMILIES:
         for n_theta, n_x in meshes:
-            P, w, wall, its = path(n_theta, n_x, membrane, args.dw)
-            maxima, p_max, w_max, fall, least = snap(P, w)
+            curve, wall, its = path(n_theta, n_x, membrane, args.dw)
+            point = demo.snap_point(curve)
+            maxima, p_max, w_max, fall, least = (point[k] for k in ("maxima", "P", "wA", "fall", "least_slope"))
             rows.append({"family": membrane, "n_theta": n_theta, "n_x": n_x, "maxima": maxima, "P_max": p_max,
                          "wA_at_P_max": w_max, "fall": fall, "least_slope": least, "wall_s": wall,
                          "iterations": its})
-            curves[(membrane, n_theta)] = (w, P)
+            curves[(membrane, n_theta)] = (curve[:, 1], curve[:, 0])
             if comm.rank == 0:
                 what = (f"P_max {p_max:.1f} at w_A {w_max:.4f}, fall {100 * fall:.3f} %" if maxima
                         else f"no maximum; flattest at P {p_max:.1f}, w_A {w_max:.4f}, dP/dw_A {least:.0f}")

@@ -80,10 +80,10 @@ W_STEPS = np.r_[np.arange(1, 24) * 0.1, 2.3 + np.arange(1, 7) * 0.025, 2.45 + np
                 2.55 + np.arange(1, 7) * 0.025, 2.8, 2.9, 3.0]
 
 
-def pullout(n_theta, n_x, w_max=3.0, membrane="opt", demo=None):
+def pullout(n_theta, n_x, w_max=3.0, membrane="opt", demo=None, w_steps=W_STEPS):
     """(P, w_A, w_B, u_C, u_D) per step, the result and the wall time; with ``demo``, the cylinder at
     w_A = 0.75, 1.5, 2.25 and 3 in ``cylinder_shapes.png``. membrane "opt" or "cst" (triangles),
-    "qm6" (quadrilaterals)."""
+    "qm6" (quadrilaterals); ``w_steps``: the driven w_A of the steps, up to ``w_max``."""
     scene = dc.Scene(large_rotations=True)
     quads = membrane == "qm6"
     shell = scene.add_shell(cylinder_eighth(R, L, n_theta, n_x, comm=comm, quads=quads), "shell", thickness=t,
@@ -96,7 +96,7 @@ def pullout(n_theta, n_x, w_max=3.0, membrane="opt", demo=None):
     for name in "ABCD":
         scene.monitor(name, shell, name)
     shots = dc.plot.Snapshots(scene, at=(0.25, 0.5, 0.75, 1.0)) if demo is not None else None
-    res, wall = timed(dc.solve, scene, dc.LoadControl(load_factors=W_STEPS / w_max), on_step=shots)
+    res, wall = timed(dc.solve, scene, dc.LoadControl(load_factors=np.asarray(w_steps) / w_max), on_step=shots)
     if demo is not None:  # the last state first: the views share the first one's camera
         demo.picture(shots.states, "cylinder_shapes.png", field="displacement", layout="grid", columns=2,
                      window_size=(1200, 1000),
@@ -133,22 +133,25 @@ COLUMNS = ["n_theta", "n_x", "distance_to_band", "distance_whole_path", "distanc
            "snap_fall"]
 
 
-def limit_points(curve):
-    """(local maxima of P along the driven w_A, those away from the snap at w_A = 2.45–2.55, the
-    snap's load, the fall of P after it relative to it). The snap's load is the largest maximum
-    at the snap, or where the path has none there, P where it is flattest (the step of least
-    dP/dw_A in the window, at its middle; the fall is then 0)."""
+def snap_point(curve) -> dict:
+    """The path's limit points: ``maxima``, the local maxima of P along the driven w_A, ``outside``,
+    those away from the snap at w_A = 2.45–2.55, the snap's load ``P`` and its ``wA``, ``fall``, the
+    fall of P after it to the valley relative to it, and ``least_slope``, the least dP/dw_A across
+    the snap. The snap's load is the largest maximum at the snap, or, where the path has none
+    there, P where it is flattest (the middle of the step of least slope; the fall is then 0)."""
     P, w = np.r_[0.0, curve[:, 0]], np.r_[0.0, curve[:, 1]]
     peaks = np.flatnonzero((P[1:-1] > P[:-2]) & (P[1:-1] >= P[2:])) + 1
     at_snap = [k for k in peaks if abs(w[k] - SNAP) <= 0.05]
+    slope = np.diff(P) / np.diff(w)
+    window = np.flatnonzero(np.abs(w[:-1] - SNAP) <= 0.05)
+    out = {"maxima": len(peaks), "outside": len(peaks) - len(at_snap), "least_slope": float(slope[window].min())}
     if not at_snap:
-        window = np.flatnonzero(np.abs(w[:-1] - SNAP) <= 0.05)
-        k = window[np.argmin(np.diff(P)[window] / np.diff(w)[window])]
-        return len(peaks), len(peaks), 0.5 * (P[k] + P[k + 1]), 0.0
+        k = window[np.argmin(slope[window])]
+        return {**out, "P": 0.5 * (P[k] + P[k + 1]), "wA": 0.5 * (w[k] + w[k + 1]), "fall": 0.0}
     k = max(at_snap, key=lambda i: P[i])
     rise = np.flatnonzero(np.diff(P[k:]) > 0.0)  # the valley: where P turns up again
     valley = P[k + rise[0]] if len(rise) else P[-1]
-    return len(peaks), len(peaks) - len(at_snap), P[k], (P[k] - valley) / P[k]
+    return {**out, "P": float(P[k]), "wA": float(w[k]), "fall": float((P[k] - valley) / P[k])}
 
 
 def three_meshes(demo):
@@ -170,7 +173,8 @@ def three_meshes(demo):
             d = distances(curve)
             k = int(np.argmin(np.abs(curve[:, 1] - W_CHECK)))
             rows.append((n_theta, n_x, d[band].max(), d.max(), *d.max(axis=0), curve[k, 0], wall,
-                         res.totals["newton_iterations"], res.totals["cuts"], curve[-1, 0], *limit_points(curve)))
+                         res.totals["newton_iterations"], res.totals["cuts"], curve[-1, 0],
+                         *(snap_point(curve)[key] for key in ("maxima", "outside", "P", "fall"))))
             snap = rows[-1][-2:]
             demo.say(f"{FAMILY[membrane]:>22s} {n_theta:2d} x {n_x:2d}: distance from Sze's table up to "
                      f"P = 20 000 {100 * d[band].max():.2f} %, whole path {100 * d.max():.2f} % (w_A "

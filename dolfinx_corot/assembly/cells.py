@@ -32,7 +32,8 @@ ghost nodes handed back whole), the AIJ matrix being made from it (:func:`aij_fr
 mirror image) only where it is read: the AMG's set-up, a fallback LU, the stability checks. The library also holds the loops of the
 co-rotated AMG hierarchy (:mod:`dolfinx_corot.assembly.amg`: the patches' moments
 ``patch_moments``, their rotations ``polar3``, the check ``unlike_rows`` and the rotation
-``rotate_rows`` of a prolongator's nodal rows).
+``rotate_rows`` of a prolongator's nodal rows) and those of the dense factorization of small
+systems (:mod:`dolfinx_corot.assembly.dense`).
 
 Used by :class:`~dolfinx_corot.assembly.system.System` for FFCx forms whose integrals are all
 cell integrals over meshes of at least :data:`MIN_CELLS` cells (on every rank).
@@ -640,6 +641,86 @@ void rotate_rows(int64_t nodes, int64_t bs, const int32_t* indptr, const double*
       }
   }
 }
+
+/* -- the dense factorization's helpers (dolfinx_corot.assembly.dense) -- */
+
+/* s_i = 1/sqrt|a_ii| of A's CSR rows (1 where a_ii = 0) */
+static void unit_diagonal_scale(int64_t n, const int32_t* indptr, const int32_t* indices, const double* values,
+                                double* s)
+{
+  for (int64_t i = 0; i < n; ++i)
+  {
+    s[i] = 1.0;
+    for (int64_t k = indptr[i]; k < indptr[i + 1]; ++k)
+      if (indices[k] == i && values[k] != 0.0)
+        s[i] = 1.0 / sqrt(fabs(values[k]));
+  }
+}
+
+/* K (n, n, column-major) = S A S, s filled */
+void scaled_dense(int64_t n, const int32_t* indptr, const int32_t* indices, const double* values, double* K,
+                  double* s)
+{
+  memset(K, 0, (size_t)(n * n) * sizeof(double));
+  unit_diagonal_scale(n, indptr, indices, values, s);
+  for (int64_t i = 0; i < n; ++i)
+    for (int64_t k = indptr[i]; k < indptr[i + 1]; ++k)
+    {
+      int64_t j = indices[k];
+      K[i + j * n] = values[k] * s[i] * s[j];
+    }
+}
+
+/* S A S in LAPACK's band storage (dgbtrf): ab (ldab, n, column-major), ab[kl + ku + i - j, j] */
+void scaled_band(int64_t n, const int32_t* indptr, const int32_t* indices, const double* values, int64_t kl,
+                 int64_t ku, int64_t ldab, double* ab, double* s)
+{
+  memset(ab, 0, (size_t)(ldab * n) * sizeof(double));
+  unit_diagonal_scale(n, indptr, indices, values, s);
+  for (int64_t i = 0; i < n; ++i)
+    for (int64_t k = indptr[i]; k < indptr[i + 1]; ++k)
+    {
+      int64_t j = indices[k];
+      ab[kl + ku + i - j + j * ldab] = values[k] * s[i] * s[j];
+    }
+}
+
+/* out = (kl, ku): the largest i - j and j - i over the stored entries of a CSR pattern */
+void bandwidths(int64_t n, const int32_t* indptr, const int32_t* indices, int64_t* out)
+{
+  int64_t kl = 0, ku = 0;
+  for (int64_t i = 0; i < n; ++i)
+    for (int64_t k = indptr[i]; k < indptr[i + 1]; ++k)
+    {
+      int64_t j = indices[k];
+      if (i - j > kl)
+        kl = i - j;
+      if (j - i > ku)
+        ku = j - i;
+    }
+  out[0] = kl;
+  out[1] = ku;
+}
+
+/* out = (row swaps, pivots with |u_ii| <= null_pivot, negative pivots) of an LU's diagonal and
+   (0-based) pivots */
+void lu_summary(int64_t n, const double* diagonal, const int32_t* piv, double null_pivot, int64_t* out)
+{
+  int64_t swaps = 0, null = 0, negative = 0;
+  for (int64_t i = 0; i < n; ++i)
+  {
+    if (piv[i] != i)
+      swaps += 1;
+    double u = diagonal[i];
+    if (fabs(u) <= null_pivot)
+      null += 1;
+    if (u < 0.0)
+      negative += 1;
+  }
+  out[0] = swaps;
+  out[1] = null;
+  out[2] = negative;
+}
 """
 
 _CDEF = """
@@ -674,6 +755,12 @@ void polar3(int64_t n, const double* H, double* R, uint8_t* ok);
 int64_t unlike_rows(int64_t nodes, int64_t bs, const int32_t* indptr, const int32_t* indices);
 void rotate_rows(int64_t nodes, int64_t bs, const int32_t* indptr, const double* base, const double* R,
                  double* values);
+void scaled_dense(int64_t n, const int32_t* indptr, const int32_t* indices, const double* values, double* K,
+                  double* s);
+void scaled_band(int64_t n, const int32_t* indptr, const int32_t* indices, const double* values, int64_t kl,
+                 int64_t ku, int64_t ldab, double* ab, double* s);
+void bandwidths(int64_t n, const int32_t* indptr, const int32_t* indices, int64_t* out);
+void lu_summary(int64_t n, const double* diagonal, const int32_t* piv, double null_pivot, int64_t* out);
 """
 
 _MODULE = None

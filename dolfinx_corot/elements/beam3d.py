@@ -30,7 +30,10 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-NPROPS = 10
+from .line_properties import NPROPS_3D
+from .line_properties import check_props_3d as check_props  # noqa: F401 (the law's checks)
+
+NPROPS = NPROPS_3D
 EA, GJ, EIY, EIZ, GAY, GAZ, N0, VX, VY, VZ = range(NPROPS)
 
 
@@ -105,12 +108,3 @@ def basic_stiffness(l0, ubar, th1, th2, props, shallow_arch, kbar):
         kbar[4 + a, 4 + a] += n * l0 * 4.0 / 30.0
         kbar[1 + a, 4 + a] -= n * l0 / 30.0
         kbar[4 + a, 1 + a] -= n * l0 / 30.0
-
-
-def check_props(values: dict, where: str) -> None:
-    """Raise ValueError naming ``where`` for non-physical section properties."""
-    for name, v in values.items():
-        if not np.isfinite(v) or v < 0.0:
-            raise ValueError(f"{where}: {name} = {v} must be finite and not negative")
-    if values["EA"] <= 0.0:
-        raise ValueError(f"{where}: axial stiffness EA = {values['EA']} must be positive")

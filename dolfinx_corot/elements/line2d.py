@@ -38,10 +38,12 @@ Bars (trusses, anchors) have ``EI = 0``; their rotations are not used and
 from __future__ import annotations
 
 import numba
-import numpy as np
+
+from .line_properties import NPROPS_2D
+from .line_properties import check_props_2d as check_props  # noqa: F401 (the law's checks)
 
 #: number of entries of ``props`` per element
-NPROPS = 4
+NPROPS = NPROPS_2D
 EA, EI, GAS, N0 = range(NPROPS)
 
 
@@ -90,14 +92,3 @@ def basic_response(l0, ubar, t1, t2, props, fbar, kbar, shallow_arch):
         kbar[2, 2] += 4.0 * nl / 30.0
         kbar[1, 2] -= nl / 30.0
         kbar[2, 1] -= nl / 30.0
-
-
-def check_props(EA: float, EI: float, GAs: float, where: str) -> None:
-    """Raise ValueError naming ``where`` for non-physical section properties."""
-    for name, v in (("EA", EA), ("EI", EI), ("GAs", GAs)):
-        if not np.isfinite(v):
-            raise ValueError(f"{where}: {name} = {v} is not finite")
-    if EA <= 0.0:
-        raise ValueError(f"{where}: axial stiffness EA = {EA} must be positive")
-    if EI < 0.0 or GAs < 0.0:
-        raise ValueError(f"{where}: EI = {EI} and GAs = {GAs} must not be negative")

@@ -23,7 +23,8 @@ spins w (R_a ← exp(w_a) R_a).
   :meth:`dolfinx_corot.assembly.System.symmetrize`);
 * :func:`since_activation`: an element added undeformed when its nodes' states were A
   (staged construction, approach II) sees the nodes at X + u_A and their states since then,
-  (u − u_A, R R_Aᵀ); the spins are unchanged (exp(w) R R_Aᵀ), so is the tangent.
+  (u − u_A, R R_Aᵀ); the spins are unchanged (exp(w) R R_Aᵀ), so is the tangent;
+* :func:`secant_quaternions`: the secant predictor of nodal states on the rotation group.
 """
 from __future__ import annotations
 
@@ -31,7 +32,8 @@ import numba
 import numpy as np
 
 from . import SYMMETRIZED  # noqa: F401 (the kernels' c[0] asking for symmetrize)
-from ..rotations import exp_so3, log_so3, matmul3, quat_mul, quat_to_matrix, quat_to_matrix_into
+from ..rotations import (exp_so3, log_so3, matmul3, quat_from_rotvec, quat_mul, quat_to_matrix, quat_to_matrix_into,
+                         rotvec_from_quat)
 
 H = 1e-30  # complex step
 
@@ -169,3 +171,17 @@ def since_activation_all(X, S, A, Xa, Sa):
     S and A (n, m, 7) → Xa, Sa."""
     for e in range(X.shape[0]):
         Xa[e], Sa[e] = since_activation(X[e], S[e], A[e])
+
+
+@numba.njit(cache=True)
+def secant_quaternions(state, older, newer, f):
+    """state (n, 7) ← (u₁ + f (u₁ − u₀), exp(f log(q₁∘q₀⁻¹))∘q₁) for every node (ghosts alike:
+    their states equal their owners'): the secant predictor on the rotation group."""
+    for i in range(state.shape[0]):
+        for k in range(3):
+            state[i, k] = newer[i, k] + f * (newer[i, k] - older[i, k])
+        q0 = older[i, 3:7].copy()
+        q0[1:] = -q0[1:]  # the inverse of a unit quaternion
+        w = rotvec_from_quat(quat_mul(newer[i, 3:7].copy(), q0))
+        q = quat_mul(quat_from_rotvec(f * w), newer[i, 3:7].copy())
+        state[i, 3:7] = q / np.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2 + q[3] ** 2)

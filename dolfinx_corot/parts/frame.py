@@ -13,7 +13,6 @@ element kernels wrapped as DOLFINx forms.
 """
 from __future__ import annotations
 
-import numba
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -21,15 +20,14 @@ from petsc4py import PETSc
 import dolfinx.fem
 import dolfinx.la
 
-from .. import _dolfinx, rotations
+from .. import _dolfinx
 from ..conditions import Condition
-from ..elements import beam3d as law3d
-from ..elements import line2d as law2d
+from ..elements import line_properties
 from ..elements import follower as follower_kernels
 from ..elements import uniform_load
 from ..io.mesh import TaggedMesh
 from ..loads import FollowerLoad
-from ..kernels import NSTATE, SYMMETRIZED, OnFirstUse
+from ..kernels import NSTATE, SYMMETRIZED, OnFirstUse, compiled
 from ..result import ElementResults
 from .base import AdditiveState, Part, PartRef
 from .cells import MeshError, check_geometry_degree, mesh_extent, refuse
@@ -484,7 +482,7 @@ class Frame2D(AdditiveState, LineFrame):
     dof_names = ("ux", "uy", "rz")
     translations = 2
     state_size = 3
-    nprops = law2d.NPROPS
+    nprops = line_properties.NPROPS_2D
     kernels = OnFirstUse("line2d")
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
@@ -502,7 +500,7 @@ class Frame2D(AdditiveState, LineFrame):
         return self._add(where, EA, 0.0, 0.0, N0, "truss")
 
     def _add(self, where, EA, EI, GAs, N0, kind):
-        law2d.check_props(EA, EI, GAs, f"{kind} '{where}'")
+        line_properties.check_props_2d(EA, EI, GAs, f"{kind} '{where}'")
         return self.add_elements(where, np.array([EA, EI, GAs, N0]), EI > 0.0, kind)
 
     def _drawn_sizes(self, cells: np.ndarray) -> np.ndarray:
@@ -570,29 +568,6 @@ class Frame2D(AdditiveState, LineFrame):
                               two_sided=True, modulus=None, cells=cells)
 
 
-@numba.njit(cache=True)
-def _secant_quaternions(state, older, newer, f):
-    """state (n, 7) ← (u₁ + f (u₁ − u₀), exp(f log(q₁∘q₀⁻¹))∘q₁) for every node (ghosts alike:
-    their states equal their owners')."""
-    for i in range(state.shape[0]):
-        for k in range(3):
-            state[i, k] = newer[i, k] + f * (newer[i, k] - older[i, k])
-        q0 = older[i, 3:7].copy()
-        q0[1:] = -q0[1:]  # the inverse of a unit quaternion
-        w = rotations.rotvec_from_quat(rotations.quat_mul(newer[i, 3:7].copy(), q0))
-        q = rotations.quat_mul(rotations.quat_from_rotvec(f * w), newer[i, 3:7].copy())
-        state[i, 3:7] = q / np.sqrt(q[0] ** 2 + q[1] ** 2 + q[2] ** 2 + q[3] ** 2)
-
-
-@numba.njit(cache=True)
-def _update_quaternions(state, dx, n):
-    """state (n, 7) ← (u + du, exp(dw)∘q) for the first n nodes; dx (n, 6)."""
-    for i in range(n):
-        for k in range(3):
-            state[i, k] += dx[i, k]
-        state[i, 3:7] = rotations.quat_update(state[i, 3:7], dx[i, 3:6].copy())
-
-
 class Rotations3D:
     """Nodal state (u, q) with multiplicative rotation updates, shared by 3D frames and surfaces."""
 
@@ -635,7 +610,7 @@ class Rotations3D:
         if self._owned_blocks is None:  # (DOLFINx makes a new DofMap wrapper at every .dofmap)
             self._owned_blocks = self.V.dofmap.index_map.size_local
         st = self.state.x.array.reshape(-1, NSTATE)
-        _update_quaternions(st, dx.array_r.reshape(-1, 6), self._owned_blocks)
+        compiled.update_quaternions(st, dx.array_r.reshape(-1, 6), self._owned_blocks)
         self.state.x.scatter_forward()
 
     def extrapolate(self, older, newer, factor):
@@ -649,7 +624,9 @@ class Rotations3D:
             raise NotImplementedError("LoadControl(extrapolate='quadratic') is not available for 3D rotations; "
                                       "use extrapolate=True (the secant on the rotation group)")
         older, newer = (np.asarray(s).reshape(-1, NSTATE) for s in states)
-        _secant_quaternions(self.state.x.array.reshape(-1, NSTATE), older, newer, -weights[0])
+        from ..kernels.spatial import secant_quaternions
+
+        secant_quaternions(self.state.x.array.reshape(-1, NSTATE), older, newer, -weights[0])
 
     def displacement_vector(self) -> PETSc.Vec:
         """Displacements in the layout of the corrections (rotational entries 0), for constraints."""
@@ -659,20 +636,20 @@ class Rotations3D:
 
     @staticmethod
     def _dof_values(s: np.ndarray) -> np.ndarray:
-        return np.concatenate([s[:3], rotations.rotvec_from_quat(s[3:7].copy())])
+        return np.concatenate([s[:3], compiled.rotvecs_from_quats(s[None, 3:7])[0]])
 
     def dof_values(self, blocks: np.ndarray) -> np.ndarray:
         """(len(blocks), 6) displacements and rotation vectors of local blocks (all nodes at once)."""
         st = self.state.x.array.reshape(-1, NSTATE)[np.asarray(blocks, dtype=np.int32)]
         out = np.empty((len(st), 6))
         out[:, :3] = st[:, :3]
-        out[:, 3:] = rotations.rotvecs_from_quats(np.ascontiguousarray(st[:, 3:7]))
+        out[:, 3:] = compiled.rotvecs_from_quats(st[:, 3:7])
         return out
 
     def _rotation_values(self) -> np.ndarray:
         """Rotation vectors (blocks, 3) of the nodal quaternions (norm ≤ π)."""
         st = self.state.x.array.reshape(-1, NSTATE)
-        return rotations.rotvecs_from_quats(np.ascontiguousarray(st[:, 3:7]))
+        return compiled.rotvecs_from_quats(st[:, 3:7])
 
     def prescribe(self, where: str, comp: int, value: float, amplitude=None, function=None,
                   condition: Condition | None = None) -> Condition:
@@ -689,7 +666,7 @@ class Frame3D(Rotations3D, LineFrame):
     gdim = 3
     dof_names = ("ux", "uy", "uz", "rx", "ry", "rz")
     translations = 3
-    nprops = law3d.NPROPS
+    nprops = line_properties.NPROPS_3D
     kernels = OnFirstUse("beam3d")
     symmetric_tangent = False  # spatial spins: K is symmetric only at equilibrium under conservative loads
 
@@ -698,6 +675,13 @@ class Frame3D(Rotations3D, LineFrame):
         self._init_state()
         # the distance from the axis at which each cell's section meets a contact surface
         self._contact_radius = np.zeros(len(self._owner_of_cell))
+
+    def _kernel_pair(self):
+        """The C kernels of :mod:`dolfinx_corot.kernels.compiled` (the numba ones' numbers, without
+        loading numba); elements added undeformed (approach II) take numba's."""
+        if self._staged_shift():
+            return self.kernels.staged_kernels()
+        return compiled.beam3d_kernels()
 
     def add_beam(self, where, section, material, kinematics, orientation, plane_strain=False) -> PartRef:
         if plane_strain:
@@ -719,7 +703,7 @@ class Frame3D(Rotations3D, LineFrame):
 
     def _add(self, where, values: dict, orientation, N0: float, kind: str):
         label = f"{kind} '{where}'"
-        law3d.check_props(values, label)
+        line_properties.check_props_3d(values, label)
         v = np.asarray(orientation, dtype=float)
         if v.shape != (3,) or not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0.0:
             raise ValueError(f"{label}: orientation must be a non-zero 3-vector, got {orientation}")

@@ -1,0 +1,102 @@
+"""The 3D beams' kernels and the nodal rotation updates in C (``beam3d.c``), compiled by cffi.
+
+A scene of beams in space then runs without numba: its import and its first load of cached
+functions (numba's target context and LLVM, about 0.45 s of a small model's whole process) are
+not paid. The C source is the same arithmetic, in the same order, as the numba kernels of
+:mod:`.beam3d` (the co-rotational element of Battini & Pacoste 2002 with its closed-form
+tangent, and the geometrically linear one) and as :func:`dolfinx_corot.rotations.quat_update`
+and :func:`~dolfinx_corot.rotations.rotvec_from_quat`; compiled without fused multiply-adds
+(``-ffp-contract=off``), it gives their numbers to rounding, which the tests check. The numba
+versions remain the reference: they also run in complex arithmetic, for the complex-step
+derivatives that check the closed-form tangent, and they serve what C does not cover (staged
+elements, section forces, follower loads).
+
+Compiled once per machine and source into the cache directory, as the assembly's loops are
+(:func:`dolfinx_corot.assembly.cells.build`).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+_CDEF = """
+void beam3d_vector(double* A, const double* w, const double* c, const double* coordinate_dofs,
+                   const int* entity_local_index, const uint8_t* quadrature_permutation);
+void beam3d_matrix(double* A, const double* w, const double* c, const double* coordinate_dofs,
+                   const int* entity_local_index, const uint8_t* quadrature_permutation);
+void update_quaternions(int64_t n, double* state, const double* dx);
+void rotvecs_from_quats(int64_t n, const double* Q, double* out);
+"""
+FLAGS = ("-O2", "-ffp-contract=off", "-g0")
+
+_MODULE = None
+
+
+def library():
+    """The cffi module of ``beam3d.c`` (built on first use, then loaded from the cache)."""
+    global _MODULE
+    if _MODULE is None:
+        from ..assembly.cells import build
+
+        source = Path(__file__).with_name("beam3d.c").read_text()
+        _MODULE = build("_dc_beam3d_", source, _CDEF, FLAGS)
+    return _MODULE
+
+
+class Kernel:
+    """A ufcx ``tabulate_tensor`` function of the library, as DOLFINx takes it (``.address``)."""
+
+    def __init__(self, name: str):
+        module = library()
+        self.name = name
+        self.address = int(module.ffi.cast("uintptr_t", module.ffi.addressof(module.lib, name)))
+
+
+def beam3d_kernels() -> tuple[Kernel, Kernel]:
+    """(vector kernel, matrix kernel) of the 3D beams: the coefficients, constants and geometry of
+    :data:`dolfinx_corot.kernels.beam3d.vector_kernel`'s."""
+    return Kernel("beam3d_vector"), Kernel("beam3d_matrix")
+
+
+def _double(ffi, a: np.ndarray, name: str):
+    if a.dtype != np.float64 or not a.flags.c_contiguous:
+        raise TypeError(f"{name}: a C-contiguous float64 array is needed, not {a.dtype} {a.flags.c_contiguous=}")
+    return ffi.cast("double*", a.ctypes.data)
+
+
+def update_quaternions(state: np.ndarray, dx: np.ndarray, n: int) -> None:
+    """state (·, 7) ← (u + du, exp(dw)∘q), renormalized, for the first n nodes; dx (≥ n, 6)."""
+    if n > len(state) or n > len(dx) or state.shape[1:] != (7,) or dx.shape[1:] != (6,):
+        raise ValueError(f"update_quaternions: states {state.shape} and corrections {dx.shape} for {n} nodes")
+    module = library()
+    module.lib.update_quaternions(n, _double(module.ffi, state, "state"), _double(module.ffi, dx, "dx"))
+
+
+def rotvecs_from_quats(Q: np.ndarray) -> np.ndarray:
+    """Rotation vectors (n, 3) of the unit quaternions Q (n, 4), each with norm in [0, π]."""
+    Q = np.ascontiguousarray(Q, dtype=np.float64)
+    if Q.ndim != 2 or Q.shape[1] != 4:
+        raise ValueError(f"rotvecs_from_quats: quaternions of shape (n, 4), not {Q.shape}")
+    out = np.empty((len(Q), 3))
+    module = library()
+    module.lib.rotvecs_from_quats(len(Q), _double(module.ffi, Q, "Q"), _double(module.ffi, out, "out"))
+    return out
+
+
+def beam3d_element(X: np.ndarray, w: np.ndarray, mode: float) -> tuple[np.ndarray, np.ndarray]:
+    """(f (12,), K (12, 12)) of one element through the two C kernels: X (2, 3) the nodes, w the
+    coefficients (the two nodal states (7,) and props (10,)), ``mode`` the constant c[0] (0
+    geometrically linear, 1 co-rotational, 2 with ½(K + Kᵀ))."""
+    module = library()
+    ffi, lib = module.ffi, module.lib
+    X = np.ascontiguousarray(X, dtype=np.float64).reshape(2, 3)
+    w = np.ascontiguousarray(w, dtype=np.float64)
+    if w.shape != (24,):
+        raise ValueError(f"beam3d_element: 24 coefficients (two states of 7, 10 properties), not {w.shape}")
+    c = np.array([float(mode)])
+    f, K = np.empty(12), np.empty((12, 12))
+    args = (_double(ffi, w, "w"), _double(ffi, c, "c"), _double(ffi, X, "X"), ffi.NULL, ffi.NULL)
+    lib.beam3d_vector(_double(ffi, f, "f"), *args)
+    lib.beam3d_matrix(_double(ffi, K, "K"), *args)
+    return f, K

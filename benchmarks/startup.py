@@ -12,8 +12,9 @@ of each are reported:
 * ``dolfinx_corot.Scene`` — what a script pays before its first scene: DOLFINx and our modules;
 * the 45° bend (Bathe & Bolourchi 1979; 8 co-rotational 3D beams from arrays, 20 load steps to
   the tip force of ``demos/curved_beam_3d.py``) as a whole process, and its time in the solver
-  (``dc.solve``) measured inside it: the first time (the beam kernels are loaded from numba's
-  cache then) and, in another process, for the same scene solved again (the solver alone).
+  (``dc.solve``) measured inside it: the first time (the C beam kernels and the dense LU's
+  helpers are loaded from the cache then, without numba) and, in another process, for the same
+  scene solved again (the solver alone).
 
 Writes output/startup_bench/{startup.json, startup.csv, startup.png}.
 Usage: python benchmarks/startup.py [--repeats 7]
@@ -51,7 +52,7 @@ def bend():
     return time.perf_counter() - t, result
 
 
-first, result = bend()  # with the beam kernels' loading from numba's cache
+first, result = bend()  # with the compiled kernels' loading from the cache
 again, _ = bend() if AGAIN else (float("nan"), None)  # the same scene again: the solver alone
 row = result.history.rows[-1]
 print("BEND", first, again, result.totals["newton_iterations"], row["tip_ux"], row["tip_uy"], row["tip_uz"])
@@ -142,7 +143,7 @@ def main() -> None:
     print(f"{'':32s} {'wall (median)':>14s} {'/ import dolfinx':>17s} {'peak RSS':>10s}")
     for r in rows:
         print(f"{r['what']:32s} {r['wall_s']:12.3f} s {r['ratio_to_import_dolfinx']:17.2f} {r['peak_rss_MB']:7.0f} MB")
-    print(f"45° bend in the solver: {bend['in_solver_first_s']:.4f} s the first time (the beam kernels loaded), "
+    print(f"45° bend in the solver: {bend['in_solver_first_s']:.4f} s the first time (the compiled kernels loaded), "
           f"{bend['in_solver_again_s']:.4f} s again; {iterations} Newton iterations, "
           f"{bend['ms_per_iteration_again']:.2f} ms each; tip displacement {tip}")
 

@@ -124,3 +124,36 @@ def test_the_dense_path_follows_the_path_of_mumps(monkeypatch):
     tips = [np.array([r.history.column(c)[-1] for c in ("tip_ux", "tip_uy", "tip_uz")]) for r in (dense, mumps)]
     assert np.linalg.norm(tips[0] - tips[1]) <= 1e-9 * np.linalg.norm(tips[1])
     assert np.linalg.norm(tips[1] - [-23.631863, -13.637087, 53.332253]) < 0.01 * np.linalg.norm(tips[1])
+
+
+def test_the_lapack_wrappers_are_scipys_and_the_helpers_match_numpy():
+    """The LAPACK module loaded without scipy.linalg's package is the one ``scipy.linalg.lapack``
+    hands out (one instance); the C helpers' scaled matrix S A S and band storage against NumPy."""
+    from scipy.linalg import lapack
+
+    from dolfinx_corot.assembly import dense
+
+    module = petsc_layer._lapack()
+    for name in ("dgetrf", "dgetrs", "dgbtrf", "dgbtrs", "dsytrf"):
+        assert getattr(module, name) is getattr(lapack, name)
+    rng = np.random.default_rng(4)
+    n = 9
+    K = np.triu(np.tril(rng.normal(size=(n, n)), 2), -1)  # kl = 1, ku = 2
+    K[3, 3] = 0.0  # a zero diagonal entry keeps scale 1
+    A = _matrix(K)
+    indptr, indices, values = A.getValuesCSR()
+    s_expected = np.where(np.diag(K) != 0.0, 1.0 / np.sqrt(np.abs(np.where(np.diag(K) != 0.0, np.diag(K), 1.0))), 1.0)
+    D = np.empty((n, n), order="F")
+    s = np.empty(n)
+    dense.scaled_dense(values, indptr, indices, D, s)
+    assert np.allclose(s, s_expected, rtol=1e-15) and np.allclose(D, s[:, None] * K * s[None, :], rtol=1e-15)
+    assert dense.bandwidths(indptr, indices) == (1, 2)
+    ab = np.empty((2 * 1 + 2 + 1, n), order="F")
+    dense.scaled_band(values, indptr, indices, 1, 2, ab, s)
+    for i in range(n):
+        for j in range(max(0, i - 1), min(n, i + 3)):
+            assert ab[1 + 2 + i - j, j] == D[i, j]
+    assert not ab[0].any()  # the fill's row
+    with pytest.raises(ValueError, match="column-major"):
+        dense.scaled_dense(values, indptr, indices, np.empty((n, n)), s)
+    assert dense.lu_summary(np.array([2.0, -1e-14, -3.0]), np.array([0, 2, 2], dtype=np.int32), 1e-13) == (1, 1, 2)

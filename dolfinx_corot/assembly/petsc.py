@@ -535,6 +535,35 @@ DENSE_LIMIT = 120  # serial LU systems up to this many dofs are factorized dense
 NULL_PIVOT = 1e-13  # a pivot of K scaled to a unit diagonal below this is null
 
 
+_LAPACK = []
+
+
+def _lapack():
+    """SciPy's LAPACK wrappers (the module ``scipy.linalg._flapack``, whose functions
+    ``scipy.linalg.lapack`` hands out), loaded from its file without importing the package
+    ``scipy.linalg`` and all its submodules (40–70 ms of a small model's whole process); through
+    ``scipy.linalg.lapack`` where SciPy keeps the module elsewhere. Python keeps one instance of an
+    extension module per file, so a later ``import scipy.linalg`` shares it."""
+    if _LAPACK:
+        return _LAPACK[0]
+    import glob
+    import importlib.machinery
+    import importlib.util
+    import os
+
+    spec = importlib.util.find_spec("scipy")
+    found = glob.glob(os.path.join(os.path.dirname(spec.origin), "linalg", "_flapack.*so")) if spec else []
+    if found:
+        name = "scipy.linalg._flapack"
+        loader = importlib.machinery.ExtensionFileLoader(name, found[0])
+        module = importlib.util.module_from_spec(importlib.util.spec_from_file_location(name, found[0], loader=loader))
+        loader.exec_module(module)
+    else:
+        from scipy.linalg import lapack as module
+    _LAPACK.append(module)
+    return module
+
+
 class DenseFactor:
     """LU (LAPACK: dgetrf, or dgbtrf for a narrow band) of a small serial PETSc matrix, with LDLᵀ (Bunch–Kaufman, dsytrf)
     for the inertia of a symmetric one.
@@ -545,10 +574,8 @@ class DenseFactor:
     null-pivot detection reports it)."""
 
     def __init__(self, A: PETSc.Mat):
-        from scipy.linalg import lapack
-
         self.A = A
-        self._lapack = lapack
+        self._lapack = _lapack()
         self.n = A.getSize()[0]
         self._state = None
         self.negative = 0

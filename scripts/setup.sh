@@ -106,9 +106,11 @@ echo "setup: installing Python packages into $venv"
 "$venv/bin/python" -m pip install -q --disable-pip-version-check --no-build-isolation -e "$here" 2>/dev/null \
     || "$venv/bin/python" -m pip install -q --disable-pip-version-check -e "$here"
 
-# the element kernels of every kind, compiled once into numba's cache (a part loads its kind's on first use)
+# the element kernels of every kind, compiled once into numba's cache (a part loads its kind's on first use),
+# and the C libraries of the beams and of the assembly's loops (cffi, into ~/.cache/dolfinx_corot)
 "$venv/bin/python" -c "import dolfinx_corot.console as c; c.announce_compilation()
 import dolfinx_corot.kernels.line2d, dolfinx_corot.kernels.beam3d, dolfinx_corot.kernels.shell3d, dolfinx_corot.kernels.membrane_quad
+import dolfinx_corot.kernels.compiled as k, dolfinx_corot.assembly.cells as a; k.library(); a.compiled()
 import dolfinx, numpy, numba; print('setup: dolfinx', dolfinx.__version__, 'numpy', numpy.__version__, 'numba', numba.__version__)"
 bytecode
 echo "$want" > "$stamp"

@@ -79,3 +79,31 @@ def test_a_scene_of_beams_in_space_is_solved_without_loading_numba():
     tip, numba_loaded = out.stdout.split()[-2:]
     assert numba_loaded == "False"
     assert float(tip) == pytest.approx(1e-3 * 10.0**3 / (3 * 1e4 / 12), rel=1e-4)
+
+
+@serial
+def test_a_scene_of_planar_beams_is_solved_without_loading_numba():
+    """A cantilever of co-rotational planar beams under an end moment 2π EI/L rolls up into a full
+    circle (the tip back at the clamp, turned by 2π: the exact elastica) in a fresh process without
+    importing numba."""
+    out = _fresh(
+        "import sys\n"
+        "import numpy as np\n"
+        "import dolfinx_corot as dc\n"
+        "from dolfinx_corot.io.mesh import from_arrays\n"
+        "n, L, E = 10, 10.0, 1e4\n"
+        "x = np.linspace(0.0, L, n + 1)\n"
+        "tm = from_arrays(np.c_[x, 0 * x], np.c_[np.arange(n), np.arange(1, n + 1)], 'axis',\n"
+        "                 {'base': np.array([0]), 'tip': np.array([n])})\n"
+        "sc = dc.Scene(large_rotations=True)\n"
+        "beam = sc.add_beam(tm, 'axis', section=dc.Section(A=1.0, I=1 / 12), material=dc.Elastic(E, 0.3))\n"
+        "sc.fix(beam, 'base')\n"
+        "sc.load(beam, 'tip', moment=2 * np.pi * E / 12 / L)\n"
+        "sc.monitor('tip', beam, 'tip')\n"
+        "row = dc.solve(sc, dc.LoadControl(steps=10), quiet=True).history.rows[-1]\n"
+        "print(row['tip_ux'], row['tip_uy'], row['tip_rz'], 'numba' in sys.modules)")
+    assert out.returncode == 0, out.stderr
+    ux, uy, rz, numba_loaded = out.stdout.split()[-4:]
+    assert numba_loaded == "False"
+    assert float(ux) == pytest.approx(-10.0, abs=1e-6) and abs(float(uy)) < 1e-6
+    assert float(rz) == pytest.approx(2 * 3.141592653589793, rel=1e-9)

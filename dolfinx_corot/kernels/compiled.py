@@ -1,11 +1,13 @@
-"""The 3D beams' kernels and the nodal rotation updates in C (``beam3d.c``), compiled by cffi.
+"""The beams' kernels (in space and in the plane) and the nodal rotation updates in C
+(``beam3d.c``, ``line2d.c``), compiled by cffi.
 
-A scene of beams in space then runs without numba: its import and its first load of cached
+A scene of beams then runs without numba: its import and its first load of cached
 functions (numba's target context and LLVM, about 0.45 s of a small model's whole process) are
 not paid. The C source is the same arithmetic, in the same order, as the numba kernels of
 :mod:`.beam3d` (the co-rotational element of Battini & Pacoste 2002 with its closed-form
-tangent, and the geometrically linear one) and as :func:`dolfinx_corot.rotations.quat_update`
-and :func:`~dolfinx_corot.rotations.rotvec_from_quat`; compiled without fused multiply-adds
+tangent, and the geometrically linear one), of :mod:`.line2d` (Crisfield's planar element)
+and as :func:`dolfinx_corot.rotations.quat_update` and
+:func:`~dolfinx_corot.rotations.rotvec_from_quat`; compiled without fused multiply-adds
 (``-ffp-contract=off``), it gives their numbers to rounding, which the tests check. The numba
 versions remain the reference: they also run in complex arithmetic, for the complex-step
 derivatives that check the closed-form tangent, and they serve what C does not cover (staged
@@ -25,21 +27,27 @@ void beam3d_vector(double* A, const double* w, const double* c, const double* co
                    const int* entity_local_index, const uint8_t* quadrature_permutation);
 void beam3d_matrix(double* A, const double* w, const double* c, const double* coordinate_dofs,
                    const int* entity_local_index, const uint8_t* quadrature_permutation);
+void line2d_vector(double* A, const double* w, const double* c, const double* coordinate_dofs,
+                   const int* entity_local_index, const uint8_t* quadrature_permutation);
+void line2d_matrix(double* A, const double* w, const double* c, const double* coordinate_dofs,
+                   const int* entity_local_index, const uint8_t* quadrature_permutation);
 void update_quaternions(int64_t n, double* state, const double* dx);
 void rotvecs_from_quats(int64_t n, const double* Q, double* out);
 """
 FLAGS = ("-O2", "-ffp-contract=off", "-g0")
+SOURCES = ("beam3d.c", "line2d.c")  # one library (line2d.c uses beam3d.c's includes)
 
 _MODULE = None
 
 
 def library():
-    """The cffi module of ``beam3d.c`` (built on first use, then loaded from the cache)."""
+    """The cffi module of ``beam3d.c`` and ``line2d.c`` (built on first use, then loaded from the cache)."""
     global _MODULE
     if _MODULE is None:
         from ..assembly.cells import build
 
-        source = Path(__file__).with_name("beam3d.c").read_text()
+        here = Path(__file__).parent
+        source = "\n".join((here / name).read_text() for name in SOURCES)
         _MODULE = build("_dc_beam3d_", source, _CDEF, FLAGS)
     return _MODULE
 
@@ -57,6 +65,12 @@ def beam3d_kernels() -> tuple[Kernel, Kernel]:
     """(vector kernel, matrix kernel) of the 3D beams: the coefficients, constants and geometry of
     :data:`dolfinx_corot.kernels.beam3d.vector_kernel`'s."""
     return Kernel("beam3d_vector"), Kernel("beam3d_matrix")
+
+
+def line2d_kernels() -> tuple[Kernel, Kernel]:
+    """(vector kernel, matrix kernel) of the planar beams and bars: the coefficients, constants and
+    geometry of :data:`dolfinx_corot.kernels.line2d.vector_kernel`'s."""
+    return Kernel("line2d_vector"), Kernel("line2d_matrix")
 
 
 def _double(ffi, a: np.ndarray, name: str):
@@ -84,19 +98,30 @@ def rotvecs_from_quats(Q: np.ndarray) -> np.ndarray:
     return out
 
 
-def beam3d_element(X: np.ndarray, w: np.ndarray, mode: float) -> tuple[np.ndarray, np.ndarray]:
-    """(f (12,), K (12, 12)) of one element through the two C kernels: X (2, 3) the nodes, w the
-    coefficients (the two nodal states (7,) and props (10,)), ``mode`` the constant c[0] (0
-    geometrically linear, 1 co-rotational, 2 with ½(K + Kᵀ))."""
+def _element(kind: str, ndof: int, ncoef: int, X, w, mode: float) -> tuple[np.ndarray, np.ndarray]:
     module = library()
     ffi, lib = module.ffi, module.lib
     X = np.ascontiguousarray(X, dtype=np.float64).reshape(2, 3)
     w = np.ascontiguousarray(w, dtype=np.float64)
-    if w.shape != (24,):
-        raise ValueError(f"beam3d_element: 24 coefficients (two states of 7, 10 properties), not {w.shape}")
+    if w.shape != (ncoef,):
+        raise ValueError(f"{kind}_element: {ncoef} coefficients, not {w.shape}")
     c = np.array([float(mode)])
-    f, K = np.empty(12), np.empty((12, 12))
+    f, K = np.empty(ndof), np.empty((ndof, ndof))
     args = (_double(ffi, w, "w"), _double(ffi, c, "c"), _double(ffi, X, "X"), ffi.NULL, ffi.NULL)
-    lib.beam3d_vector(_double(ffi, f, "f"), *args)
-    lib.beam3d_matrix(_double(ffi, K, "K"), *args)
+    getattr(lib, kind + "_vector")(_double(ffi, f, "f"), *args)
+    getattr(lib, kind + "_matrix")(_double(ffi, K, "K"), *args)
     return f, K
+
+
+def beam3d_element(X: np.ndarray, w: np.ndarray, mode: float) -> tuple[np.ndarray, np.ndarray]:
+    """(f (12,), K (12, 12)) of one element through the two C kernels: X (2, 3) the nodes, w the
+    coefficients (the two nodal states (7,) and props (10,)), ``mode`` the constant c[0] (0
+    geometrically linear, 1 co-rotational, 2 with ½(K + Kᵀ))."""
+    return _element("beam3d", 12, 24, X, w, mode)
+
+
+def line2d_element(X: np.ndarray, w: np.ndarray, mode: float) -> tuple[np.ndarray, np.ndarray]:
+    """(f (6,), K (6, 6)) of one planar element through the two C kernels: X (2, 3) the nodes
+    (z = 0), w the coefficients ((u, v, θ) of both nodes, props (EA, EI, GAs, N0)), ``mode`` the
+    constant c[0] (0 geometrically linear, 1 co-rotational)."""
+    return _element("line2d", 6, 10, X, w, mode)

@@ -293,10 +293,17 @@ class LineFrame(Part):
         """Per-cell constants of the kernels (none by default)."""
         return []
 
+    #: the function of :mod:`dolfinx_corot.kernels.compiled` that gives the part's C kernels (the
+    #: numba kernels' numbers without loading numba); None: the numba kernels of ``kernels``
+    compiled_kernels: str | None = None
+
     def _kernel_pair(self):
-        """(vector kernel, matrix kernel) of the elements (approach II: of elements added undeformed)."""
+        """(vector kernel, matrix kernel) of the elements (approach II: of elements added undeformed,
+        numba's)."""
         if self._staged_shift():
             return self.kernels.staged_kernels()
+        if self.compiled_kernels is not None:
+            return getattr(compiled, self.compiled_kernels)()
         return self.kernels.vector_kernel, self.kernels.matrix_kernel
 
     # -- staged construction (dolfinx_corot.staging) ---------------------------------
@@ -484,6 +491,7 @@ class Frame2D(AdditiveState, LineFrame):
     state_size = 3
     nprops = line_properties.NPROPS_2D
     kernels = OnFirstUse("line2d")
+    compiled_kernels = "line2d_kernels"
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
         super().__init__(tmesh, large_rotations)
@@ -668,6 +676,7 @@ class Frame3D(Rotations3D, LineFrame):
     translations = 3
     nprops = line_properties.NPROPS_3D
     kernels = OnFirstUse("beam3d")
+    compiled_kernels = "beam3d_kernels"
     symmetric_tangent = False  # spatial spins: K is symmetric only at equilibrium under conservative loads
 
     def __init__(self, tmesh: TaggedMesh, large_rotations: bool):
@@ -675,13 +684,6 @@ class Frame3D(Rotations3D, LineFrame):
         self._init_state()
         # the distance from the axis at which each cell's section meets a contact surface
         self._contact_radius = np.zeros(len(self._owner_of_cell))
-
-    def _kernel_pair(self):
-        """The C kernels of :mod:`dolfinx_corot.kernels.compiled` (the numba ones' numbers, without
-        loading numba); elements added undeformed (approach II) take numba's."""
-        if self._staged_shift():
-            return self.kernels.staged_kernels()
-        return compiled.beam3d_kernels()
 
     def add_beam(self, where, section, material, kinematics, orientation, plane_strain=False) -> PartRef:
         if plane_strain:

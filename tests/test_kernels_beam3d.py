@@ -226,3 +226,24 @@ def test_the_c_nodal_updates_give_the_numba_updates_numbers():
     assert np.linalg.norm(got, axis=1).max() <= np.pi
     with pytest.raises(ValueError, match="states"):
         compiled.update_quaternions(state, dx, n + 10)
+
+
+@pytest.mark.parametrize("large", [True, False])
+def test_the_c_section_forces_give_the_numba_numbers(large):
+    """The section forces and element axes of many elements at random states (the element results'
+    path), C against :func:`~dolfinx_corot.kernels.beam3d.section_forces_all`."""
+    rng = np.random.default_rng(9)
+    n = 40
+    X, S, props = np.empty((n, 2, 3)), np.empty((n, 2, 7)), np.empty((n, 10))
+    for e in range(n):
+        X1, X2, s1, s2, _ = _random_state(rng)
+        X[e], S[e] = (X1, X2), (s1, s2)
+        props[e] = PROPS[list(PROPS)[e % len(PROPS)]]
+    out, axes = np.empty((n, 2, 6)), np.empty((n, 3, 3))
+    compiled.section_forces_all(X, S, props, large, out, axes)
+    expected, expected_axes = np.empty((n, 2, 6)), np.empty((n, 3, 3))
+    k.section_forces_all(X, S, props, large, expected, expected_axes)
+    assert np.array_equal(axes, expected_axes)
+    assert np.abs(out - expected).max() <= (1e-15 if large else 1e-12) * np.abs(expected).max()
+    with pytest.raises(ValueError, match="props"):
+        compiled.section_forces_all(X, S, props[:, :4].copy(), large, out, axes)

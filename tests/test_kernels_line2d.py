@@ -140,3 +140,20 @@ def test_the_c_kernels_give_the_numba_kernels_numbers(kind):
             f, K = _eval(X, d, PROPS[kind], large, "C")
             fn, Kn = _eval(X, d, PROPS[kind], large)
             assert np.array_equal(f, fn) and np.array_equal(K, Kn), (kind, large)
+
+
+def test_the_c_element_loop_gives_the_numba_numbers():
+    """The end forces of many elements (the element results' path), C against
+    :func:`~dolfinx_corot.kernels.line2d.evaluate_all`, bit for bit."""
+    rng = np.random.default_rng(12)
+    n = 50
+    X, D, props = np.empty((n, 2, 2)), np.empty((n, 6)), np.empty((n, 4))
+    for e in range(n):
+        X[e], D[e] = _random_state(rng)
+        props[e] = PROPS[list(PROPS)[e % len(PROPS)]]
+    for large in (True, False):
+        F, K = np.empty((n, 6)), np.empty((n, 6, 6))
+        compiled.evaluate_all_2d(X, D, props, large, F, K)
+        Fn, Kn = np.empty((n, 6)), np.empty((n, 6, 6))
+        k.evaluate_all(X, D, props, large, Fn, Kn)
+        assert np.array_equal(F, Fn) and np.array_equal(K, Kn)

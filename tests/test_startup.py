@@ -54,10 +54,12 @@ def test_a_fresh_process_that_imports_the_package_first_runs_mpi_and_petsc_as_an
 
 @serial
 def test_a_scene_of_beams_in_space_is_solved_without_loading_numba():
-    """The 3D beams' kernels, the nodal rotation updates and the dense factorization's helpers are C
-    (:mod:`dolfinx_corot.kernels.compiled`, :mod:`dolfinx_corot.assembly.dense`): a cantilever of
-    co-rotational beams is solved in a fresh process without importing numba, and its tip under a
-    small end load is Euler–Bernoulli's P L³/(3 E I) (to the load's geometric nonlinearity, 1e-4)."""
+    """The 3D beams' kernels, the nodal rotation updates, the section forces and the dense
+    factorization's helpers are C (:mod:`dolfinx_corot.kernels.compiled`,
+    :mod:`dolfinx_corot.assembly.dense`): a cantilever of co-rotational beams is solved and its
+    section forces read in a fresh process without importing numba; its tip under a small end load
+    is Euler–Bernoulli's P L³/(3 E I), the clamp's moment P L (to the load's geometric
+    nonlinearity, 1e-4)."""
     out = _fresh(
         "import sys\n"
         "import numpy as np\n"
@@ -74,18 +76,20 @@ def test_a_scene_of_beams_in_space_is_solved_without_loading_numba():
         "sc.load(beam, 'tip', force=(0.0, 1e-3, 0.0))\n"
         "sc.monitor('tip', beam, 'tip')\n"
         "result = dc.solve(sc, dc.LoadControl(steps=2), quiet=True)\n"
-        "print(result.history.rows[-1]['tip_uy'], 'numba' in sys.modules)")
+        "moment = sc.element_results(beam)['My'][0, 0]  # e2 = z, e3 = -y: bending about e2\n"
+        "print(result.history.rows[-1]['tip_uy'], moment, 'numba' in sys.modules)")
     assert out.returncode == 0, out.stderr
-    tip, numba_loaded = out.stdout.split()[-2:]
+    tip, moment, numba_loaded = out.stdout.split()[-3:]
     assert numba_loaded == "False"
     assert float(tip) == pytest.approx(1e-3 * 10.0**3 / (3 * 1e4 / 12), rel=1e-4)
+    assert abs(float(moment)) == pytest.approx(1e-3 * 10.0, rel=1e-4)  # the clamp's moment P L
 
 
 @serial
 def test_a_scene_of_planar_beams_is_solved_without_loading_numba():
     """A cantilever of co-rotational planar beams under an end moment 2π EI/L rolls up into a full
-    circle (the tip back at the clamp, turned by 2π: the exact elastica) in a fresh process without
-    importing numba."""
+    circle (the tip back at the clamp, turned by 2π: the exact elastica), its bending moment that
+    moment everywhere, in a fresh process without importing numba."""
     out = _fresh(
         "import sys\n"
         "import numpy as np\n"
@@ -101,9 +105,12 @@ def test_a_scene_of_planar_beams_is_solved_without_loading_numba():
         "sc.load(beam, 'tip', moment=2 * np.pi * E / 12 / L)\n"
         "sc.monitor('tip', beam, 'tip')\n"
         "row = dc.solve(sc, dc.LoadControl(steps=10), quiet=True).history.rows[-1]\n"
-        "print(row['tip_ux'], row['tip_uy'], row['tip_rz'], 'numba' in sys.modules)")
+        "M = np.abs(sc.element_results(beam)['M'])\n"
+        "print(row['tip_ux'], row['tip_uy'], row['tip_rz'], M.min(), M.max(), 'numba' in sys.modules)")
     assert out.returncode == 0, out.stderr
-    ux, uy, rz, numba_loaded = out.stdout.split()[-4:]
+    ux, uy, rz, m_min, m_max, numba_loaded = out.stdout.split()[-6:]
     assert numba_loaded == "False"
+    moment = 2 * 3.141592653589793 * 1e4 / 12 / 10.0
+    assert float(m_min) == pytest.approx(moment, rel=1e-6) and float(m_max) == pytest.approx(moment, rel=1e-6)
     assert float(ux) == pytest.approx(-10.0, abs=1e-6) and abs(float(uy)) < 1e-6
     assert float(rz) == pytest.approx(2 * 3.141592653589793, rel=1e-9)

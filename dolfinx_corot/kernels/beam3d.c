@@ -659,6 +659,54 @@ void beam3d_matrix(double* A, const double* w, const double* c, const double* co
   tabulate(w, c, coordinate_dofs, f, A, 1);
 }
 
+/* out (n, 2, 6): the section forces (N, Vy, Vz, T, My, Mz) at both ends of every element, in its
+   current axes (the initial ones if !large_rotations): -R^T f1 at end 1, +R^T f2 at end 2 of the
+   nodal forces f; axes (n, 3, 3): rows e1, e2, e3 (kernels.beam3d.section_forces_all) */
+void beam3d_section_forces_all(int64_t n, const double* X, const double* S, const double* props,
+                               int64_t large_rotations, double* out, double* axes)
+{
+  const double c = large_rotations ? 1.0 : 0.0;
+  for (int64_t e = 0; e < n; ++e)
+  {
+    const double* Xe = X + 6 * e;
+    const double* Se = S + 2 * NSTATE * e;
+    const double* pe = props + NPROPS * e;
+    double w[2 * NSTATE + NPROPS], f[12], K[144];
+    memcpy(w, Se, 2 * NSTATE * sizeof(double));
+    memcpy(w + 2 * NSTATE, pe, NPROPS * sizeof(double));
+    tabulate(w, &c, Xe, f, K, 0);
+    m3 R0, Rr;
+    initial_frame(Xe, Xe + 3, pe + P_VX, R0);
+    memcpy(Rr, R0, sizeof(m3));
+    if (large_rotations)
+    {
+      double u[2][3], p1[3], p2[3];
+      m3 R[2];
+      nodal_states(Se, u, R);
+      current_frame(Xe, Xe + 3, u[0], u[1], R[0], R[1], R0, Rr, p1, p2);
+    }
+    double* oe = out + 12 * e;
+    for (int a = 0; a < 2; ++a)
+    {
+      double sign = a == 0 ? -1.0 : 1.0;
+      for (int i = 0; i < 3; ++i)
+      {
+        double F = 0.0, M = 0.0;
+        for (int k = 0; k < 3; ++k)
+        {
+          F += Rr[k][i] * f[6 * a + k];
+          M += Rr[k][i] * f[6 * a + 3 + k];
+        }
+        oe[6 * a + i] = sign * F;
+        oe[6 * a + 3 + i] = sign * M;
+      }
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        axes[9 * e + 3 * i + j] = Rr[j][i];
+  }
+}
+
 /* -- nodal rotations (rotations.quat_update, rotvec_from_quat) -------------------------------- */
 
 /* state (n, 7) <- (u + du, exp(dw) q) for the first n nodes; dx (n, 6) */

@@ -11,7 +11,8 @@ and as :func:`dolfinx_corot.rotations.quat_update` and
 (``-ffp-contract=off``), it gives their numbers to rounding, which the tests check. The numba
 versions remain the reference: they also run in complex arithmetic, for the complex-step
 derivatives that check the closed-form tangent, and they serve what C does not cover (staged
-elements, section forces, follower loads).
+elements, follower loads). The element results (the 3D beams' section forces, the planar
+elements' end forces) are C as well.
 
 Compiled once per machine and source into the cache directory, as the assembly's loops are
 (:func:`dolfinx_corot.assembly.cells.build`).
@@ -31,6 +32,10 @@ void line2d_vector(double* A, const double* w, const double* c, const double* co
                    const int* entity_local_index, const uint8_t* quadrature_permutation);
 void line2d_matrix(double* A, const double* w, const double* c, const double* coordinate_dofs,
                    const int* entity_local_index, const uint8_t* quadrature_permutation);
+void beam3d_section_forces_all(int64_t n, const double* X, const double* S, const double* props,
+                               int64_t large_rotations, double* out, double* axes);
+void line2d_evaluate_all(int64_t n, const double* X, const double* D, const double* props, int64_t large_rotations,
+                         double* F, double* K);
 void update_quaternions(int64_t n, double* state, const double* dx);
 void rotvecs_from_quats(int64_t n, const double* Q, double* out);
 """
@@ -77,6 +82,37 @@ def _double(ffi, a: np.ndarray, name: str):
     if a.dtype != np.float64 or not a.flags.c_contiguous:
         raise TypeError(f"{name}: a C-contiguous float64 array is needed, not {a.dtype} {a.flags.c_contiguous=}")
     return ffi.cast("double*", a.ctypes.data)
+
+
+def _arrays(ffi, name: str, **arrays):
+    """The pointers of float64 arrays of the given shapes ({name: (array, shape)})."""
+    out = []
+    for key, (a, shape) in arrays.items():
+        if a.shape != shape:
+            raise ValueError(f"{name}: {key} of shape {shape}, not {a.shape}")
+        out.append(_double(ffi, a, key))
+    return out
+
+
+def section_forces_all(X, S, props, large_rotations: bool, out, axes) -> None:
+    """:func:`dolfinx_corot.kernels.beam3d.section_forces_all` in C: X (n, 2, 3), S (n, 2, 7),
+    props (n, 10) → out (n, 2, 6) the section forces (N, Vy, Vz, T, My, Mz) at both ends in the
+    elements' axes, axes (n, 3, 3) their rows e1, e2, e3."""
+    n = len(X)
+    module = library()
+    pointers = _arrays(module.ffi, "section_forces_all", X=(X, (n, 2, 3)), S=(S, (n, 2, 7)), props=(props, (n, 10)),
+                       out=(out, (n, 2, 6)), axes=(axes, (n, 3, 3)))
+    module.lib.beam3d_section_forces_all(n, *pointers[:3], int(bool(large_rotations)), *pointers[3:])
+
+
+def evaluate_all_2d(X, D, props, large_rotations: bool, F, K) -> None:
+    """:func:`dolfinx_corot.kernels.line2d.evaluate_all` in C: X (n, 2, 2), D (n, 6), props (n, 4)
+    → F (n, 6), K (n, 6, 6)."""
+    n = len(X)
+    module = library()
+    pointers = _arrays(module.ffi, "evaluate_all_2d", X=(X, (n, 2, 2)), D=(D, (n, 6)), props=(props, (n, 4)),
+                       F=(F, (n, 6)), K=(K, (n, 6, 6)))
+    module.lib.line2d_evaluate_all(n, *pointers[:3], int(bool(large_rotations)), *pointers[3:])
 
 
 def update_quaternions(state: np.ndarray, dx: np.ndarray, n: int) -> None:

@@ -192,3 +192,14 @@ void line2d_matrix(double* A, const double* w, const double* c, const double* co
   const double* X = coordinate_dofs;
   l2_evaluate(X[0], X[1], X[3], X[4], w, w + 6, c[0] != 0.0, f, A);
 }
+
+/* all elements: X (n, 2, 2), D (n, 6), props (n, 4) -> F (n, 6), K (n, 6, 6) (kernels.line2d.evaluate_all) */
+void line2d_evaluate_all(int64_t n, const double* X, const double* D, const double* props, int64_t large_rotations,
+                         double* F, double* K)
+{
+  for (int64_t e = 0; e < n; ++e)
+  {
+    const double* Xe = X + 4 * e;
+    l2_evaluate(Xe[0], Xe[1], Xe[2], Xe[3], D + 6 * e, props + 4 * e, large_rotations != 0, F + 6 * e, K + 36 * e);
+  }
+}

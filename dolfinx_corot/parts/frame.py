@@ -530,8 +530,8 @@ class Frame2D(AdditiveState, LineFrame):
         X = np.ascontiguousarray(X[:, :, :2])
         F = np.zeros((len(cells), 6))
         K = np.zeros((len(cells), 6, 6))
-        self.kernels.evaluate_all(X, np.ascontiguousarray(S.reshape(-1, 6)), self.cell_properties(cells),
-                                  self.large_rotations, F, K)
+        compiled.evaluate_all_2d(X, np.ascontiguousarray(S.reshape(-1, 6)),
+                                 np.ascontiguousarray(self.cell_properties(cells)), self.large_rotations, F, K)
         return F, X
 
     section_components = ("N", "V", "M")
@@ -729,9 +729,9 @@ class Frame3D(Rotations3D, LineFrame):
         X, S = self._element_states(cells)
         values = np.empty((len(cells), 2, 6))
         axes = np.empty((len(cells), 3, 3))
-        self.kernels.section_forces_all(np.ascontiguousarray(X), np.ascontiguousarray(S),
-                                        np.ascontiguousarray(self.cell_properties(cells)), self.large_rotations,
-                                        values, axes)
+        compiled.section_forces_all(np.ascontiguousarray(X), np.ascontiguousarray(S),
+                                    np.ascontiguousarray(self.cell_properties(cells)), self.large_rotations,
+                                    values, axes)
         span = self._span_loads(cells)  # less the span loads' nodal share, in the element's axes
         for end, sign in ((0, -1.0), (1, 1.0)):
             values[:, end, :3] -= sign * np.einsum("nij,nj->ni", axes, span[:, end, :3])

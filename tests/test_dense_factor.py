@@ -126,6 +126,17 @@ def test_the_dense_path_follows_the_path_of_mumps(monkeypatch):
     assert np.linalg.norm(tips[1] - [-23.631863, -13.637087, 53.332253]) < 0.01 * np.linalg.norm(tips[1])
 
 
+def test_without_scipys_module_file_the_lapack_wrappers_come_from_scipy_linalg(monkeypatch):
+    """Where SciPy keeps no ``linalg/_flapack`` file, the dense LU takes ``scipy.linalg.lapack``."""
+    import glob
+
+    from scipy.linalg import lapack
+
+    monkeypatch.setattr(petsc_layer, "_LAPACK", [])
+    monkeypatch.setattr(glob, "glob", lambda pattern: [])
+    assert petsc_layer._lapack() is lapack
+
+
 def test_the_lapack_wrappers_are_scipys_and_the_helpers_match_numpy():
     """The LAPACK module loaded without scipy.linalg's package is the one ``scipy.linalg.lapack``
     hands out (one instance); the C helpers' scaled matrix S A S and band storage against NumPy."""

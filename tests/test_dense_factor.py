@@ -168,3 +168,55 @@ def test_the_lapack_wrappers_are_scipys_and_the_helpers_match_numpy():
     with pytest.raises(ValueError, match="column-major"):
         dense.scaled_dense(values, indptr, indices, np.empty((n, n)), s)
     assert dense.lu_summary(np.array([2.0, -1e-14, -3.0]), np.array([0, 2, 2], dtype=np.int32), 1e-13) == (1, 1, 2)
+
+
+class _Factor:
+    """A stand-in for MUMPS's factor matrix that runs out of workspace until ICNTL(14) ≥ ``needs``."""
+
+    def __init__(self, needs: int, code: int):
+        self.icntl14, self.needs, self.code, self.solved = 20, needs, code, 0
+
+    def getMumpsInfog(self, i):
+        return self.code if i == 1 and self.icntl14 < self.needs else 0
+
+    def getMumpsIcntl(self, i):
+        return self.icntl14
+
+    def setMumpsIcntl(self, i, value):
+        assert i == 14
+        self.icntl14 = value
+
+
+class _KSP:
+    def __init__(self, factor):
+        self.factor = factor
+
+    def getPC(self):
+        return self
+
+    def getFactorMatrix(self):
+        return self.factor
+
+    def solve(self, rhs, out):
+        self.factor.solved += 1
+
+    def getConvergedReason(self):
+        return -11 if self.factor.getMumpsInfog(1) else 1
+
+
+@pytest.mark.parametrize("code, needs, solves, icntl14, reason",
+                         [(-9, 45, 1, 50, 1), (-9, 150, 3, 200, 1), (-8, 10_000, 4, 400, -11), (-10, 45, 0, 20, -11)])
+def test_a_factorization_out_of_workspace_is_done_again_with_more(code, needs, solves, icntl14, reason):
+    """MUMPS's workspace errors (INFOG(1) = −9 here) make the solver factorize again with twice the
+    extra space ICNTL(14) (at least 50 %), up to four times, and keep it; other failures (−10: a
+    singular matrix) are not retried, and the message names MUMPS's error."""
+    from dolfinx_corot.assembly.petsc import LinearSolver
+
+    solver = LinearSolver.__new__(LinearSolver)
+    solver.A, solver.mumps = PETSc.Mat().createAIJ([1, 1], nnz=1, comm=MPI.COMM_SELF), True
+    solver.A.setUp()
+    solver.A.assemble()
+    solver.ksp = _KSP(_Factor(needs, code))
+    assert solver._mumps_retry(None, None) == reason
+    assert solver.ksp.factor.solved == solves and solver.ksp.factor.icntl14 == icntl14
+    assert f"MUMPS INFOG(1) = {0 if reason > 0 else code}" in solver._mumps_error()

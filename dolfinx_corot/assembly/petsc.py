@@ -533,6 +533,10 @@ def destroy(*objects) -> None:
 # -- the linear solver ------------------------------------------------------------------
 DENSE_LIMIT = 120  # serial LU systems up to this many dofs are factorized densely (LAPACK)
 NULL_PIVOT = 1e-13  # a pivot of K scaled to a unit diagonal below this is null
+#: MUMPS's errors of a workspace too small (INFOG(1): −8, −9 the factors' integer and real
+#: arrays, −11, −12, −14, −15 those of the solution and its refinement, −17, −20 the
+#: communication buffers), all cured by a larger ICNTL(14) (MUMPS 5 users' guide, §8)
+MUMPS_WORKSPACE_ERRORS = (-8, -9, -11, -12, -14, -15, -17, -20)
 
 
 _LAPACK = []
@@ -800,8 +804,10 @@ class LinearSolver:
                            reason, self.ksp.getIterationNumber())
             reason = self._direct_solve(rhs, out)
             self.prolongator = None  # the next hierarchy is built anew
+        if reason < 0 and self.mumps:
+            reason = self._mumps_retry(rhs, out)
         if reason < 0:
-            raise np.linalg.LinAlgError(f"linear solve failed (PETSc reason {reason}); "
+            raise np.linalg.LinAlgError(f"linear solve failed (PETSc reason {reason}{self._mumps_error()}); "
                                         "the tangent may be singular (a missing support?)")
         if self.mumps:
             F = self.ksp.getPC().getFactorMatrix()
@@ -827,6 +833,35 @@ class LinearSolver:
         """A's values from the block operator, where the tangent was assembled into it alone."""
         if self.operator is not None:
             self.operator.sync()
+
+    def _mumps_retry(self, rhs: PETSc.Vec, out: PETSc.Vec) -> int:
+        """A factorization that MUMPS stopped for want of workspace is done again with twice the
+        extra space (ICNTL 14, the percentage added to the analysis's estimate; kept for the later
+        factorizations), up to four times. The estimate can fall short where numerical pivoting
+        delays pivots (an unsymmetric contact tangent by LU), and on several ranks by a margin that
+        varies from run to run with MUMPS's dynamic scheduling. PETSc's reason of the last
+        attempt."""
+        reason = self.ksp.getConvergedReason()
+        F = self.ksp.getPC().getFactorMatrix()
+        for _ in range(4):
+            if F.getMumpsInfog(1) not in MUMPS_WORKSPACE_ERRORS:
+                break
+            extra = max(2 * int(F.getMumpsIcntl(14)), 50)
+            logger.warning("MUMPS ran out of workspace (INFOG(1) = %d): factorizing again with ICNTL(14) = %d",
+                           F.getMumpsInfog(1), extra)
+            F.setMumpsIcntl(14, extra)
+            self.A.assemble()  # (its state changes: the factorization is made again)
+            self.ksp.solve(rhs, out)
+            reason = self.ksp.getConvergedReason()
+            if reason >= 0:
+                break
+        return reason
+
+    def _mumps_error(self) -> str:
+        """MUMPS's error code after a failed solve (INFOG(1), 0 if none), for the message."""
+        if not self.mumps:
+            return ""
+        return f", MUMPS INFOG(1) = {int(self.ksp.getPC().getFactorMatrix().getMumpsInfog(1))}"
 
     def _direct_solve(self, rhs: PETSc.Vec, out: PETSc.Vec) -> int:
         self.sync_aij()

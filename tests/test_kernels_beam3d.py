@@ -79,7 +79,8 @@ def test_tangent_matches_finite_differences(kind, large, impl):
                     r = rot.rotvec_from_quat(lst[node][3:].copy())
                     r[c - 3] += sgn * h
                     lst[node][3:] = rot.quat_from_rotvec(r)
-            Kfd[:, j] = (_eval(X1, X2, *plus, props, large, impl)[0] - _eval(X1, X2, *minus, props, large, impl)[0]) / (2 * h)
+            Kfd[:, j] = (_eval(X1, X2, *plus, props, large, impl)[0]
+                         - _eval(X1, X2, *minus, props, large, impl)[0]) / (2 * h)
         err = np.abs(K - Kfd).max() / np.abs(K).max()
         assert err < 1e-6, (kind, large, err)
 

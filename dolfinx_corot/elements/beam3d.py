@@ -31,7 +31,6 @@ import numba
 import numpy as np
 
 from .line_properties import NPROPS_3D
-from .line_properties import check_props_3d as check_props  # noqa: F401 (the law's checks)
 
 NPROPS = NPROPS_3D
 EA, GJ, EIY, EIZ, GAY, GAZ, N0, VX, VY, VZ = range(NPROPS)

@@ -40,7 +40,6 @@ from __future__ import annotations
 import numba
 
 from .line_properties import NPROPS_2D
-from .line_properties import check_props_2d as check_props  # noqa: F401 (the law's checks)
 
 #: number of entries of ``props`` per element
 NPROPS = NPROPS_2D

@@ -23,6 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..elements.line_properties import NPROPS_2D, NPROPS_3D
+from . import NSTATE as NSTATE_3D  # a node's state in space: u (3), quaternion (4)
+
 _CDEF = """
 void beam3d_vector(double* A, const double* w, const double* c, const double* coordinate_dofs,
                    const int* entity_local_index, const uint8_t* quadrature_permutation);
@@ -100,8 +103,8 @@ def section_forces_all(X, S, props, large_rotations: bool, out, axes) -> None:
     elements' axes, axes (n, 3, 3) their rows e1, e2, e3."""
     n = len(X)
     module = library()
-    pointers = _arrays(module.ffi, "section_forces_all", X=(X, (n, 2, 3)), S=(S, (n, 2, 7)), props=(props, (n, 10)),
-                       out=(out, (n, 2, 6)), axes=(axes, (n, 3, 3)))
+    pointers = _arrays(module.ffi, "section_forces_all", X=(X, (n, 2, 3)), S=(S, (n, 2, NSTATE_3D)),
+                       props=(props, (n, NPROPS_3D)), out=(out, (n, 2, 6)), axes=(axes, (n, 3, 3)))
     module.lib.beam3d_section_forces_all(n, *pointers[:3], int(bool(large_rotations)), *pointers[3:])
 
 
@@ -110,14 +113,14 @@ def evaluate_all_2d(X, D, props, large_rotations: bool, F, K) -> None:
     → F (n, 6), K (n, 6, 6)."""
     n = len(X)
     module = library()
-    pointers = _arrays(module.ffi, "evaluate_all_2d", X=(X, (n, 2, 2)), D=(D, (n, 6)), props=(props, (n, 4)),
+    pointers = _arrays(module.ffi, "evaluate_all_2d", X=(X, (n, 2, 2)), D=(D, (n, 6)), props=(props, (n, NPROPS_2D)),
                        F=(F, (n, 6)), K=(K, (n, 6, 6)))
     module.lib.line2d_evaluate_all(n, *pointers[:3], int(bool(large_rotations)), *pointers[3:])
 
 
 def update_quaternions(state: np.ndarray, dx: np.ndarray, n: int) -> None:
     """state (·, 7) ← (u + du, exp(dw)∘q), renormalized, for the first n nodes; dx (≥ n, 6)."""
-    if n > len(state) or n > len(dx) or state.shape[1:] != (7,) or dx.shape[1:] != (6,):
+    if n > len(state) or n > len(dx) or state.shape[1:] != (NSTATE_3D,) or dx.shape[1:] != (6,):
         raise ValueError(f"update_quaternions: states {state.shape} and corrections {dx.shape} for {n} nodes")
     module = library()
     module.lib.update_quaternions(n, _double(module.ffi, state, "state"), _double(module.ffi, dx, "dx"))
@@ -153,11 +156,11 @@ def beam3d_element(X: np.ndarray, w: np.ndarray, mode: float) -> tuple[np.ndarra
     """(f (12,), K (12, 12)) of one element through the two C kernels: X (2, 3) the nodes, w the
     coefficients (the two nodal states (7,) and props (10,)), ``mode`` the constant c[0] (0
     geometrically linear, 1 co-rotational, 2 with ½(K + Kᵀ))."""
-    return _element("beam3d", 12, 24, X, w, mode)
+    return _element("beam3d", 12, 2 * NSTATE_3D + NPROPS_3D, X, w, mode)
 
 
 def line2d_element(X: np.ndarray, w: np.ndarray, mode: float) -> tuple[np.ndarray, np.ndarray]:
     """(f (6,), K (6, 6)) of one planar element through the two C kernels: X (2, 3) the nodes
     (z = 0), w the coefficients ((u, v, θ) of both nodes, props (EA, EI, GAs, N0)), ``mode`` the
     constant c[0] (0 geometrically linear, 1 co-rotational)."""
-    return _element("line2d", 6, 10, X, w, mode)
+    return _element("line2d", 6, 6 + NPROPS_2D, X, w, mode)

@@ -472,6 +472,73 @@ def test_cg_reads_the_tangent_s_upper_triangle_in_nodal_blocks(n, degree):
     system.destroy()
 
 
+
+@pytest.mark.parametrize("n", [(6, 2, 2), (6, 3)], ids=["hex-Q1", "plane-Q2"])
+def test_the_block_operator_s_compiled_product_is_petsc_s_to_the_last_bit(n):
+    """The product of the SBAIJ operator (3 × 3 and 2 × 2 blocks) is a compiled loop installed as
+    the matrix's MATOP_MULT (on several ranks: of its diagonal block, which PETSc's MPISBAIJ
+    product calls), the operations of PETSc's in PETSc's order: at a deformed state with
+    supports it gives PETSc's product of the same values (an operator made with
+    ``-dc_sbaij_product false``, which keeps PETSc's) to the last bit, and the AIJ tangent's
+    product to round-off, before and after a new tangent."""
+    from dolfinx_corot.assembly import cells, petsc
+
+    if len(n) == 3:
+        sc = _deformed_block("hexahedron", 1, dc.SaintVenantKirchhoff(1e5, 0.3), n=n)
+    else:
+        sc = dc.Scene(linear_solver="iterative")
+        b = sc.add_solid(_rectangle(*n, True), material=dc.NeoHookean(E, 0.3), degree=2)
+        sc.fix(b, "left")
+        sc.load(b, "right", traction=(0.0, -1.0))
+    system = make_system(sc.model, solver="iterative")
+    rng = np.random.default_rng(5)
+    _move_to(system, sc.model, 0.01 * rng.normal(size=sc.model.state.x.array.size))
+    system.residual(0.5)
+    system.jacobian()
+    A = system.A
+    ops = {}
+    for installed in (True, False):
+        options = PETSc.Options()
+        if not installed:
+            options["dc_sbaij_product"] = "false"
+        try:
+            ops[installed] = petsc.SymmetricBlockOperator(A)
+        finally:
+            if not installed:
+                del options["dc_sbaij_product"]
+        ops[installed].refresh()
+    ctypes, lib, _, _ = petsc._petsc_library()
+    module = cells.compiled()
+    ours = int(module.ffi.cast("uintptr_t", module.ffi.addressof(module.lib, "sbaij_mult")))
+
+    def product_of(op):
+        target = op.S if MPI.COMM_WORLD.size == 1 else op.S.getDiagonalBlock()
+        f = ctypes.c_void_p()
+        assert lib.MatGetOperation(ctypes.c_void_p(target.handle), petsc._MATOP_MULT, ctypes.byref(f)) == 0
+        return f.value
+
+    assert product_of(ops[True]) == ours
+    assert product_of(ops[False]) != ours
+    x, y, z, w = A.createVecRight(), A.createVecLeft(), A.createVecLeft(), A.createVecLeft()
+    for k in range(3):
+        x.setArray(rng.normal(size=x.getLocalSize()))
+        ops[True].S.mult(x, y)
+        ops[False].S.mult(x, w)
+        assert np.array_equal(y.array_r, w.array_r)
+        A.mult(x, z)
+        assert np.linalg.norm(y.array_r - z.array_r) <= 1e-13 * np.linalg.norm(z.array_r)
+    # a new tangent: the same values' address, the product follows them
+    _move_to(system, sc.model, 0.02 * rng.normal(size=sc.model.state.x.array.size))
+    system.residual(0.5)
+    system.jacobian()
+    for op in ops.values():
+        op.refresh()
+    ops[True].S.mult(x, y)
+    ops[False].S.mult(x, w)
+    assert np.array_equal(y.array_r, w.array_r)
+    petsc.destroy(ops[True], ops[False], x, y, z, w)
+    system.destroy()
+
 def _true_linear_residuals(sc, system, steps=3):
     """Solve the bent block and return, for each inexact Newton solve, the true linear residual
     ‖b − K x‖ / ‖b‖ it left and the tolerance η the forcing term asked of it."""

@@ -60,8 +60,8 @@ def copy(v: PETSc.Vec) -> PETSc.Vec:
 def _petsc_library():
     """(ctypes, the PETSc library petsc4py is linked to, PetscInt*, PetscInt) with the argument
     types of the calls petsc4py 3.18 lacks: ``MatGetRowIJ``, ``MatSeqAIJGetArray[Read]``,
-    ``MatSeqSBAIJGetArray``, ``MatMPIAIJGetSeqAIJ``, ``MatGetSize``, ``MatSeqAIJSetColumnIndices``
-    and their Restore calls."""
+    ``MatSeqSBAIJGetArray``, ``MatMPIAIJGetSeqAIJ``, ``MatGetSize``, ``MatSeqAIJSetColumnIndices``,
+    ``MatGetOperation``, ``MatSetOperation`` and their Restore calls."""
     global _LIBRARY
     if _LIBRARY is None:
         import ctypes
@@ -88,11 +88,28 @@ def _petsc_library():
         lib.MatGetSize.restype = ctypes.c_int
         lib.MatSeqAIJSetColumnIndices.argtypes = [ctypes.c_void_p, p_int]
         lib.MatSeqAIJSetColumnIndices.restype = ctypes.c_int
+        lib.MatGetOperation.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.POINTER(ctypes.c_void_p)]
+        lib.MatGetOperation.restype = ctypes.c_int
+        lib.MatSetOperation.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_void_p]
+        lib.MatSetOperation.restype = ctypes.c_int
         _LIBRARY = (ctypes, lib, p_int, int_t)
     return _LIBRARY
 
 
 _LIBRARY = None
+_MATOP_MULT = 3  # PETSc 3.18's MatOperation MATOP_MULT
+_SBAIJ_API = []
+
+
+def _sbaij_api(module) -> None:
+    """Hands the compiled SBAIJ product (cells.sbaij_mult) the PETSc calls it makes, once."""
+    if _SBAIJ_API:
+        return
+    ctypes, lib, _, _ = _petsc_library()
+    names = ("VecGetArrayRead", "VecRestoreArrayRead", "VecGetArrayWrite", "VecRestoreArrayWrite", "MatGetBlockSize")
+    addresses = [module.ffi.cast("void*", ctypes.cast(getattr(lib, n), ctypes.c_void_p).value) for n in names]
+    module.lib.sbaij_api(*addresses)
+    _SBAIJ_API.append(True)
 
 
 class SeqAIJArrays:
@@ -229,6 +246,78 @@ class SymmetricBlockOperator:
             S.setLGMap(*A.getLGMap())  # the rows of ghost nodes go to their owners by local index
             self._off_values = np.zeros((len(self._split[2]), bs * bs))
             self._diagonal_vec = S.createVecLeft()
+        # S's product by the compiled loop (cells.sbaij_mult): PETSc's numbers, 0.75-0.85 of its time
+        self._product = None
+        if (compiled and bs in (2, 3) and np.dtype(PETSc.IntType) == np.int32
+                and (self.serial or self._split is not None)
+                and PETSc.Options().getBool("dc_sbaij_product", True)):
+            self._product = self._install_product()
+
+    def _product_target(self):
+        """(the SeqSBAIJ matrix whose product is compiled: S or its diagonal block, its block CSR)."""
+        if self._split is not None:
+            bi_d, bj_d = self._split[0], self._split[1]
+            return self.S.getDiagonalBlock().handle, bi_d, bj_d
+        return self.S.handle, self.bi, self.bj
+
+    def _install_product(self):
+        """Installs the compiled product as the MATOP_MULT of S (one rank) or of its diagonal
+        block (several: PETSc's MPISBAIJ product calls the diagonal block's); returns the
+        matrix's handle, or None where nothing was installed (an empty block, all slots taken)."""
+        from . import cells
+
+        ctypes, lib, _, _ = _petsc_library()
+        handle, bi, bj = self._product_target()
+        if int(bi[-1]) == 0:
+            return None
+        module = cells.compiled()
+        ffi = module.ffi
+        _sbaij_api(module)
+        h = ctypes.c_void_p(handle)
+        original = ctypes.c_void_p()
+        if lib.MatGetOperation(h, _MATOP_MULT, ctypes.byref(original)) or not original.value:
+            return None
+        if not self._register_product(module, handle, bi, bj, original.value):
+            return None
+        mult = int(ffi.cast("uintptr_t", ffi.addressof(module.lib, "sbaij_mult")))
+        if lib.MatSetOperation(h, _MATOP_MULT, ctypes.c_void_p(mult)):
+            module.lib.sbaij_forget(ffi.cast("void*", handle))
+            return None
+        self._original_product = original.value
+        import weakref
+
+        self._forget = weakref.finalize(self, module.lib.sbaij_forget, ffi.cast("void*", handle))
+        return handle
+
+    def _register_product(self, module, handle: int, bi, bj, original: int) -> bool:
+        """(Re-)registers the matrix at ``handle`` with its pattern and the current address of
+        its values (where PETSc keeps them: fixed while the pattern is)."""
+        ctypes, lib, _, _ = _petsc_library()
+        h = ctypes.c_void_p(handle)
+        v = ctypes.POINTER(ctypes.c_double)()
+        if lib.MatSeqSBAIJGetArray(h, ctypes.byref(v)):
+            return False
+        address = ctypes.cast(v, ctypes.c_void_p).value
+        lib.MatSeqSBAIJRestoreArray(h, ctypes.byref(v))
+        if not address:
+            return False
+        ffi = module.ffi
+        return module.lib.sbaij_register(ffi.cast("void*", handle), (len(bi) - 1), self.bs,
+                                         ffi.cast("int32_t*", bi.ctypes.data), ffi.cast("int32_t*", bj.ctypes.data),
+                                         ffi.cast("double*", address), ffi.cast("void*", original)) == 0
+
+    def _recheck_product(self) -> None:
+        """After an assembly of S: its values' address registered anew (should PETSc have moved them)."""
+        if self._product is None:
+            return
+        from . import cells
+
+        handle, bi, bj = self._product_target()
+        if not self._register_product(cells.compiled(), handle, bi, bj, self._original_product):
+            # (cannot happen while the pattern is fixed) PETSc's product back
+            ctypes, lib, _, _ = _petsc_library()
+            lib.MatSetOperation(ctypes.c_void_p(handle), _MATOP_MULT, ctypes.c_void_p(self._original_product))
+            self._product = None
 
     @staticmethod
     def _upper_blocks(parts, bs: int, first_block: int, chunk: int = 4096):
@@ -337,6 +426,7 @@ class SymmetricBlockOperator:
             self._diagonal = values.reshape(-1, bs * bs)[self.bi[:-1], :: bs + 1].ravel()
 
         self._upper_values(action)
+        self._recheck_product()
         self.upper_newer = True
         self.assembled = True
         # A's diagonal follows (its state changes): the Jacobi smoothers of a kept hierarchy,
@@ -361,6 +451,7 @@ class SymmetricBlockOperator:
         if len(rows):  # lower blocks among them are dropped (IGNORE_LOWER_TRIANGULAR)
             S.setValuesBlockedLocalRCV(rows, columns, ghost, addv=PETSc.InsertMode.ADD_VALUES)
         S.assemble()
+        self._recheck_product()
         S.getDiagonal(self._diagonal_vec)
         self._diagonal = self._diagonal_vec.array_r.copy()
         self.upper_newer = True
@@ -432,6 +523,7 @@ class SymmetricBlockOperator:
         else:
             self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.A.convert("sbaij", S)
+        self._recheck_product()
         self._state = self.A.stateGet()
 
     def _refresh_split(self) -> None:
@@ -451,6 +543,9 @@ class SymmetricBlockOperator:
         self.S.assemble()
 
     def destroy(self) -> None:
+        if self._product is not None:
+            self._forget()  # (once: the registration is gone before S is)
+            self._product = None
         self.S.destroy()
         if self._split is not None:
             self._diagonal_vec.destroy()

@@ -857,6 +857,61 @@ def test_the_corotated_prolongator_is_the_built_one_turned_node_by_node(compiled
     system.destroy()
 
 
+
+@pytest.mark.parametrize("d", [3, 2], ids=["block", "plane"])
+def test_the_restriction_by_the_nodal_loop_is_petsc_s_transpose_product_to_the_last_bit(d):
+    """The V-cycle's restriction Pᵀ r with the kept finest prolongator is a compiled loop over its
+    nodes (the rows of a node share their columns; installed as the matrix's
+    MATOP_MULT_TRANSPOSE on one rank, PETSc's MPIAIJ product on several): PETSc's product
+    (of a copy of P) to the last bit, before and after the prolongator is turned, and PETSc's
+    own again once it is restored."""
+    from dolfinx_corot.assembly import amg, petsc
+
+    if d == 3:
+        sc = _cantilever_block((12, 2, 2))
+    else:
+        sc = dc.Scene()
+        b = sc.add_solid(_rectangle(24, 4, True), material=dc.NeoHookean(E, 0.3), degree=1)
+        sc.fix(b, "left")
+        sc.load(b, "right", traction=(0.0, -1.0))
+    system = make_system(sc.model, solver="iterative")
+    system.residual(0.0)
+    system.jacobian()
+    system.solve()
+    pc = system.linear.ksp.getPC()
+    prolongator = amg.CorotatedProlongator(pc, d)
+    P = prolongator.P
+    products = prolongator.transpose_products
+    assert len(products) == (1 if comm.size == 1 else 0) and all(p.installed for p in products)
+    n = system.A.getLocalSize()[0] // d
+    rng = np.random.default_rng(comm.rank + 7)
+    r, ours, theirs = P.createVecLeft(), P.createVecRight(), P.createVecRight()
+
+    def same():
+        copy = P.duplicate(copy=True)  # a new matrix: PETSc's product
+        r.setArray(rng.normal(size=r.getLocalSize()))
+        P.multTranspose(r, ours)
+        copy.multTranspose(r, theirs)
+        copy.destroy()
+        return np.array_equal(ours.array_r, theirs.array_r)
+
+    assert same()
+    R = np.array([_rotation(rng.normal(size=3), rng.uniform(0.0, 3.0)) for _ in range(n)])
+    if d == 2:
+        angle = rng.uniform(-3.0, 3.0, size=n)
+        R = np.stack([np.stack([np.cos(angle), -np.sin(angle)], -1), np.stack([np.sin(angle), np.cos(angle)], -1)], 1)
+    prolongator.rotate(R)
+    assert same()
+    ctypes, lib, _, _ = petsc._petsc_library()
+    for product in products:
+        product.restore()
+        f = ctypes.c_void_p()
+        assert lib.MatGetOperation(ctypes.c_void_p(product.handle), petsc._MATOP_MULT_TRANSPOSE, ctypes.byref(f)) == 0
+        assert f.value == product.original and not product.installed
+    assert same()
+    petsc.destroy(r, ours, theirs)
+    system.destroy()
+
 def test_the_amg_hierarchy_is_kept_from_step_to_step_co_rotated():
     """The cantilever block bent until its end has turned by about 1.2 rad, in 4 steps, CG + AMG:
     with the hierarchy of the first step kept and its finest prolongator co-rotated by the

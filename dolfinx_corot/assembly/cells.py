@@ -722,33 +722,40 @@ void lu_summary(int64_t n, const double* diagonal, const int32_t* piv, double nu
   out[2] = negative;
 }
 
-/* The product y = S x of a SeqSBAIJ matrix with 2 x 2 or 3 x 3 blocks (PETSc's layout: the
-   upper block triangle, block rows bi/bj, each block column-major, the diagonal block first in
-   its row and read from its upper half), installed as the matrix's MATOP_MULT. The same
-   operations in the same order as PETSc 3.18's MatMult_SeqSBAIJ_2/3, so the same numbers to the
-   last bit; the block row's own sums are kept in registers instead of memory, which PETSc's
-   compiler cannot do for fear of aliasing (0.75-0.85 of PETSc's time on the 116 k-dof block).
-   The matrices are registered with their pattern and values (the pattern is fixed, so the value
-   array stays where it is); one that is not goes to PETSc's own product of its block size. */
+/* Products of PETSc matrices by compiled loops, installed as the matrices' operations
+   (MatSetOperation) and reading PETSc's own arrays, registered with the matrix:
+   - y = S x of a SeqSBAIJ matrix with 2 x 2 or 3 x 3 blocks (PETSc's layout: the upper block
+     triangle, each block column-major, the diagonal block first in its row and read from its
+     upper half), as MATOP_MULT: the operations of PETSc 3.18's MatMult_SeqSBAIJ_2/3 in their
+     order, so the same numbers to the last bit; the block row's own sums are kept in registers
+     instead of memory, which PETSc's compiler cannot do for fear of aliasing (0.75-0.85 of
+     PETSc's time on the 116 k-dof block);
+   - y = P^T x of a SeqAIJ matrix whose rows come in groups of bs (a node's) with the same
+     columns (AMG's prolongators), as MATOP_MULT_TRANSPOSE: each column's index and each entry
+     of y read and written once per node instead of once per row, the rows' contributions added
+     in PETSc's order (MatMultTranspose_SeqAIJ), so the same numbers to the last bit.
+   The pattern is fixed, so the value arrays stay where they are. A matrix that carries the
+   operation but is not registered (its registration forgotten) goes to PETSc's own. */
 typedef int (*dc_vec_read_t)(void*, const double**);
 typedef int (*dc_vec_write_t)(void*, double**);
 typedef int (*dc_mult_t)(void*, void*, void*);
 static dc_vec_read_t dc_get_read = 0, dc_restore_read = 0;
 static dc_vec_write_t dc_get_write = 0, dc_restore_write = 0;
 static int (*dc_block_size)(void*, int32_t*) = 0;
-static dc_mult_t dc_petsc_mult[4] = {0, 0, 0, 0};
+static dc_mult_t dc_petsc_sbaij_mult[4] = {0, 0, 0, 0};
+static dc_mult_t dc_petsc_aij_mult_transpose = 0;
 
-#define DC_SBAIJ_SLOTS 64
+#define DC_PRODUCT_SLOTS 256
 typedef struct
 {
   void* mat;
-  int64_t nb, bs;
-  const int32_t *bi, *bj;
+  int64_t token, kind, n, ncols, bs; /* kind 1: SBAIJ product (n block rows); 2: AIJ transpose (n rows, ncols) */
+  const int32_t *ia, *ja;
   const double* v;
-} dc_sbaij_t;
-static dc_sbaij_t dc_sbaij[DC_SBAIJ_SLOTS];
+} dc_product_t;
+static dc_product_t dc_products[DC_PRODUCT_SLOTS];
 
-void sbaij_api(void* get_read, void* restore_read, void* get_write, void* restore_write, void* block_size)
+void product_api(void* get_read, void* restore_read, void* get_write, void* restore_write, void* block_size)
 {
   dc_block_size = (int (*)(void*, int32_t*))block_size;
   dc_get_read = (dc_vec_read_t)get_read;
@@ -757,32 +764,45 @@ void sbaij_api(void* get_read, void* restore_read, void* get_write, void* restor
   dc_restore_write = (dc_vec_write_t)restore_write;
 }
 
-/* 0, or -1 where all slots are taken; petsc_mult: PETSc's product of this block size */
-int64_t sbaij_register(void* mat, int64_t nb, int64_t bs, const int32_t* bi, const int32_t* bj, const double* v,
-                       void* petsc_mult)
+/* 0, or -1 where all slots are taken; petsc_op: PETSc's own operation (the fallback) */
+int64_t product_register(void* mat, int64_t token, int64_t kind, int64_t n, int64_t ncols, int64_t bs,
+                         const int32_t* ia, const int32_t* ja, const double* v, void* petsc_op)
 {
-  int64_t free_slot = -1;
-  for (int64_t s = 0; s < DC_SBAIJ_SLOTS; ++s)
-  {
-    if (dc_sbaij[s].mat == mat || (free_slot < 0 && dc_sbaij[s].mat == 0))
-      free_slot = s;
-    if (dc_sbaij[s].mat == mat)
+  int64_t slot = -1;
+  for (int64_t s = 0; s < DC_PRODUCT_SLOTS; ++s)
+    if (dc_products[s].mat == mat)
+    {
+      slot = s;
       break;
-  }
-  if (free_slot < 0)
+    }
+  for (int64_t s = 0; slot < 0 && s < DC_PRODUCT_SLOTS; ++s)
+    if (dc_products[s].mat == 0)
+      slot = s;
+  if (slot < 0)
     return -1;
-  dc_sbaij_t e = {mat, nb, bs, bi, bj, v};
-  dc_sbaij[free_slot] = e;
-  if (bs >= 2 && bs <= 3)
-    dc_petsc_mult[bs] = (dc_mult_t)petsc_mult;
+  dc_product_t e = {mat, token, kind, n, ncols, bs, ia, ja, v};
+  dc_products[slot] = e;
+  if (kind == 1 && bs >= 2 && bs <= 3)
+    dc_petsc_sbaij_mult[bs] = (dc_mult_t)petsc_op;
+  if (kind == 2)
+    dc_petsc_aij_mult_transpose = (dc_mult_t)petsc_op;
   return 0;
 }
 
-void sbaij_forget(void* mat)
+/* forgets the registration of mat made with token (not a later one of a matrix at that address) */
+void product_forget(void* mat, int64_t token)
 {
-  for (int64_t s = 0; s < DC_SBAIJ_SLOTS; ++s)
-    if (dc_sbaij[s].mat == mat)
-      dc_sbaij[s].mat = 0;
+  for (int64_t s = 0; s < DC_PRODUCT_SLOTS; ++s)
+    if (dc_products[s].mat == mat && dc_products[s].token == token)
+      dc_products[s].mat = 0;
+}
+
+static const dc_product_t* dc_product(void* mat, int64_t kind)
+{
+  for (int64_t s = 0; s < DC_PRODUCT_SLOTS; ++s)
+    if (dc_products[s].mat == mat && dc_products[s].kind == kind)
+      return &dc_products[s];
+  return 0;
 }
 
 static void dc_sbaij3(int64_t nb, const int32_t* restrict bi, const int32_t* restrict bj,
@@ -807,10 +827,10 @@ static void dc_sbaij3(int64_t nb, const int32_t* restrict bi, const int32_t* res
     for (; k < end; ++k, b += 9)
     {
       const int64_t c = 3 * (int64_t)bj[k];
-      z[c] += b[0] * x1 + b[1] * x2 + b[2] * x3; /* the block's transpose into row block j */
+      z[c] += b[0] * x1 + b[1] * x2 + b[2] * x3; /* the block's transpose into block row j */
       z[c + 1] += b[3] * x1 + b[4] * x2 + b[5] * x3;
       z[c + 2] += b[6] * x1 + b[7] * x2 + b[8] * x3;
-      s1 += b[0] * x[c] + b[3] * x[c + 1] + b[6] * x[c + 2]; /* the block into row block i */
+      s1 += b[0] * x[c] + b[3] * x[c + 1] + b[6] * x[c + 2]; /* the block into block row i */
       s2 += b[1] * x[c] + b[4] * x[c + 1] + b[7] * x[c + 2];
       s3 += b[2] * x[c] + b[5] * x[c + 1] + b[8] * x[c + 2];
     }
@@ -851,43 +871,98 @@ static void dc_sbaij2(int64_t nb, const int32_t* restrict bi, const int32_t* res
   }
 }
 
+/* z (ncols, zeroed first) = P^T x, P's rows in nodes of bs rows with the same columns */
+static void dc_nodal_transpose(int64_t nrows, int64_t bs, int64_t ncols, const int32_t* restrict ia,
+                               const int32_t* restrict ja, const double* restrict v, const double* restrict x,
+                               double* restrict z)
+{
+  memset(z, 0, sizeof(double) * ncols);
+  for (int64_t r = 0; r < nrows; r += bs)
+  {
+    const int64_t start = ia[r], len = ia[r + 1] - ia[r];
+    const int32_t* col = ja + start;
+    if (bs == 3)
+    {
+      const double *v0 = v + start, *v1 = v + ia[r + 1], *v2 = v + ia[r + 2];
+      const double a0 = x[r], a1 = x[r + 1], a2 = x[r + 2];
+      for (int64_t k = 0; k < len; ++k)
+      {
+        double t = z[col[k]];
+        t += a0 * v0[k];
+        t += a1 * v1[k];
+        t += a2 * v2[k];
+        z[col[k]] = t;
+      }
+    }
+    else
+    {
+      for (int64_t k = 0; k < len; ++k)
+      {
+        double t = z[col[k]];
+        for (int64_t b = 0; b < bs; ++b)
+          t += x[r + b] * v[ia[r + b] + k];
+        z[col[k]] = t;
+      }
+    }
+  }
+}
+
+static int dc_arrays(void* x, const double** px, void* y, double** py)
+{
+  int ierr = dc_get_read(x, px);
+  if (ierr)
+    return ierr;
+  if ((ierr = dc_get_write(y, py)))
+    dc_restore_read(x, px);
+  return ierr;
+}
+
+static int dc_restore(void* x, const double** px, void* y, double** py)
+{
+  int ierr = dc_restore_write(y, py);
+  int ierr2 = dc_restore_read(x, px);
+  return ierr ? ierr : ierr2;
+}
+
 /* MATOP_MULT of a registered SeqSBAIJ matrix (PETSc's calling convention: Mat, Vec x, Vec y) */
 int sbaij_mult(void* mat, void* x, void* y)
 {
-  const dc_sbaij_t* e = 0;
-  for (int64_t s = 0; s < DC_SBAIJ_SLOTS; ++s)
-    if (dc_sbaij[s].mat == mat)
-    {
-      e = &dc_sbaij[s];
-      break;
-    }
+  const dc_product_t* e = dc_product(mat, 1);
   if (!e)
   {
-    int32_t bs = 0; /* (a copy of a registered matrix, should PETSc copy its operations) */
+    int32_t bs = 0;
     int ierr = dc_block_size(mat, &bs);
     if (ierr)
       return ierr;
-    if (bs >= 2 && bs <= 3 && dc_petsc_mult[bs])
-      return dc_petsc_mult[bs](mat, x, y);
+    if (bs >= 2 && bs <= 3 && dc_petsc_sbaij_mult[bs])
+      return dc_petsc_sbaij_mult[bs](mat, x, y);
     return 73; /* PETSC_ERR_ARG_WRONGSTATE */
   }
   const double* px;
   double* py;
-  int ierr = dc_get_read(x, &px);
+  int ierr = dc_arrays(x, &px, y, &py);
   if (ierr)
     return ierr;
-  if ((ierr = dc_get_write(y, &py)))
-  {
-    dc_restore_read(x, &px);
-    return ierr;
-  }
   if (e->bs == 3)
-    dc_sbaij3(e->nb, e->bi, e->bj, e->v, px, py);
+    dc_sbaij3(e->n, e->ia, e->ja, e->v, px, py);
   else
-    dc_sbaij2(e->nb, e->bi, e->bj, e->v, px, py);
-  ierr = dc_restore_write(y, &py);
-  int ierr2 = dc_restore_read(x, &px);
-  return ierr ? ierr : ierr2;
+    dc_sbaij2(e->n, e->ia, e->ja, e->v, px, py);
+  return dc_restore(x, &px, y, &py);
+}
+
+/* MATOP_MULT_TRANSPOSE of a registered SeqAIJ matrix of nodal rows (y: its columns) */
+int nodal_mult_transpose(void* mat, void* x, void* y)
+{
+  const dc_product_t* e = dc_product(mat, 2);
+  if (!e)
+    return dc_petsc_aij_mult_transpose ? dc_petsc_aij_mult_transpose(mat, x, y) : 73;
+  const double* px;
+  double* py;
+  int ierr = dc_arrays(x, &px, y, &py);
+  if (ierr)
+    return ierr;
+  dc_nodal_transpose(e->n, e->bs, e->ncols, e->ia, e->ja, e->v, px, py);
+  return dc_restore(x, &px, y, &py);
 }
 """
 
@@ -929,11 +1004,12 @@ void scaled_band(int64_t n, const int32_t* indptr, const int32_t* indices, const
                  int64_t ku, int64_t ldab, double* ab, double* s);
 void bandwidths(int64_t n, const int32_t* indptr, const int32_t* indices, int64_t* out);
 void lu_summary(int64_t n, const double* diagonal, const int32_t* piv, double null_pivot, int64_t* out);
-void sbaij_api(void* get_read, void* restore_read, void* get_write, void* restore_write, void* block_size);
-int64_t sbaij_register(void* mat, int64_t nb, int64_t bs, const int32_t* bi, const int32_t* bj, const double* v,
-                       void* petsc_mult);
-void sbaij_forget(void* mat);
+void product_api(void* get_read, void* restore_read, void* get_write, void* restore_write, void* block_size);
+int64_t product_register(void* mat, int64_t token, int64_t kind, int64_t n, int64_t ncols, int64_t bs,
+                         const int32_t* ia, const int32_t* ja, const double* v, void* petsc_op);
+void product_forget(void* mat, int64_t token);
 int sbaij_mult(void* mat, void* x, void* y);
+int nodal_mult_transpose(void* mat, void* x, void* y);
 """
 
 _MODULE = None

@@ -97,19 +97,139 @@ def _petsc_library():
 
 
 _LIBRARY = None
-_MATOP_MULT = 3  # PETSc 3.18's MatOperation MATOP_MULT
-_SBAIJ_API = []
+_MATOP_MULT, _MATOP_MULT_TRANSPOSE = 3, 5  # PETSc 3.18's MatOperation
+_PRODUCT_API = []
+_PRODUCT_TOKENS = iter(range(1, 2 ** 62))
 
 
-def _sbaij_api(module) -> None:
-    """Hands the compiled SBAIJ product (cells.sbaij_mult) the PETSc calls it makes, once."""
-    if _SBAIJ_API:
+def _compiled_cells():
+    from . import cells
+
+    return cells.compiled()
+
+
+def _product_api(module) -> None:
+    """Hands the compiled products (cells.sbaij_mult, cells.nodal_mult_transpose) the PETSc
+    calls they make, once."""
+    if _PRODUCT_API:
         return
     ctypes, lib, _, _ = _petsc_library()
     names = ("VecGetArrayRead", "VecRestoreArrayRead", "VecGetArrayWrite", "VecRestoreArrayWrite", "MatGetBlockSize")
     addresses = [module.ffi.cast("void*", ctypes.cast(getattr(lib, n), ctypes.c_void_p).value) for n in names]
-    module.lib.sbaij_api(*addresses)
-    _SBAIJ_API.append(True)
+    module.lib.product_api(*addresses)
+    _PRODUCT_API.append(True)
+
+
+class CompiledProduct:
+    """A product of the sequential PETSc matrix at ``handle`` by a compiled loop of
+    :mod:`dolfinx_corot.assembly.cells`, installed as its operation ``op`` (MATOP_MULT: the
+    SBAIJ product ``sbaij_mult``, kind 1; MATOP_MULT_TRANSPOSE: the nodal AIJ transpose
+    ``nodal_mult_transpose``, kind 2), with the pattern (ia, ja: kept alive by the caller) and
+    values it reads. ``installed`` is False where nothing could be (an empty matrix, no slot);
+    :meth:`forget` ends the registration (PETSc's own product then serves the matrix)."""
+
+    _FUNCTIONS = {1: (_MATOP_MULT, "sbaij_mult"), 2: (_MATOP_MULT_TRANSPOSE, "nodal_mult_transpose")}
+
+    def __init__(self, handle: int, kind: int, n: int, ncols: int, bs: int, ia: np.ndarray, ja: np.ndarray):
+        import weakref
+
+        self.handle, self.kind, self.n, self.ncols, self.bs = int(handle), kind, n, ncols, bs
+        self.ia, self.ja = ia, ja
+        self.installed = False
+        self.module = module = _compiled_cells()
+        if n == 0 or len(ja) == 0:
+            return
+        _product_api(module)
+        ctypes, lib, _, _ = _petsc_library()
+        op, name = self._FUNCTIONS[kind]
+        h = ctypes.c_void_p(self.handle)
+        original = ctypes.c_void_p()
+        if lib.MatGetOperation(h, op, ctypes.byref(original)) or not original.value:
+            return
+        self.original = original.value
+        self.token = next(_PRODUCT_TOKENS)
+        if not self.register():
+            return
+        ffi = module.ffi
+        address = int(ffi.cast("uintptr_t", ffi.addressof(module.lib, name)))
+        if lib.MatSetOperation(h, op, ctypes.c_void_p(address)):
+            self.forget()
+            return
+        self.installed = True
+        self._finalizer = weakref.finalize(self, module.lib.product_forget, ffi.cast("void*", self.handle),
+                                           self.token)
+
+    def _values(self) -> int:
+        """The address of the matrix's values (PETSc's array)."""
+        ctypes, lib, _, _ = _petsc_library()
+        h = ctypes.c_void_p(self.handle)
+        v = ctypes.POINTER(ctypes.c_double)()
+        get, restore = (("MatSeqSBAIJGetArray", "MatSeqSBAIJRestoreArray") if self.kind == 1 else
+                        ("MatSeqAIJGetArrayRead", "MatSeqAIJRestoreArrayRead"))
+        if getattr(lib, get)(h, ctypes.byref(v)):
+            return 0
+        address = ctypes.cast(v, ctypes.c_void_p).value or 0
+        getattr(lib, restore)(h, ctypes.byref(v))
+        return address
+
+    def register(self) -> bool:
+        """(Re-)registers the matrix with the current address of its values (fixed while its
+        pattern is; checked after each assembly)."""
+        address = self._values()
+        if not address:
+            return False
+        ffi, lib = self.module.ffi, self.module.lib
+        return lib.product_register(ffi.cast("void*", self.handle), self.token, self.kind, self.n, self.ncols,
+                                    self.bs, ffi.cast("int32_t*", self.ia.ctypes.data),
+                                    ffi.cast("int32_t*", self.ja.ctypes.data), ffi.cast("double*", address),
+                                    ffi.cast("void*", self.original)) == 0
+
+    def recheck(self) -> None:
+        """After an assembly: registered anew, or PETSc's product back where that fails."""
+        if self.installed and not self.register():
+            self.restore()
+
+    def restore(self) -> None:
+        """PETSc's own product back."""
+        if self.installed:
+            ctypes, lib, _, _ = _petsc_library()
+            lib.MatSetOperation(ctypes.c_void_p(self.handle), self._FUNCTIONS[self.kind][0],
+                                ctypes.c_void_p(self.original))
+            self.forget()
+
+    def forget(self) -> None:
+        if getattr(self, "_finalizer", None) is not None:
+            self._finalizer()
+        else:
+            self.module.lib.product_forget(self.module.ffi.cast("void*", self.handle), getattr(self, "token", 0))
+        self.installed = False
+
+
+def nodal_transpose_products(P: PETSc.Mat, bs: int) -> list[CompiledProduct]:
+    """The transpose product of AMG's prolongator P on one rank (SeqAIJ), whose rows come in
+    nodes of ``bs`` with the same columns, by the compiled nodal
+    loop (:class:`CompiledProduct`, kind 2): PETSc's numbers to the last bit, each column read
+    once a node instead of once a row. Nothing where PetscInt is not 32-bit or
+    ``-dc_nodal_transpose false``."""
+    if np.dtype(PETSc.IntType) != np.int32 or not PETSc.Options().getBool("dc_nodal_transpose", True):
+        return []
+    if P.getType() != "seqaij":  # (one rank: on several, PETSc's MPIAIJ product)
+        return []
+    ctypes, lib, p_int, int_t = _petsc_library()
+    handles = [P.handle]
+    products = []
+    for handle in handles:
+        with SeqAIJArrays(handle, write=False) as (indptr, indices, _):
+            rows = len(indptr) - 1
+        m, n = int_t(0), int_t(0)
+        lib.MatGetSize(ctypes.c_void_p(handle), ctypes.byref(m), ctypes.byref(n))
+        if rows % bs:
+            continue
+        # (PETSc's own structure: the arrays live as long as the matrix)
+        product = CompiledProduct(handle, 2, rows, n.value, bs, indptr, indices)
+        if product.installed:
+            products.append(product)
+    return products
 
 
 class SeqAIJArrays:
@@ -260,64 +380,18 @@ class SymmetricBlockOperator:
             return self.S.getDiagonalBlock().handle, bi_d, bj_d
         return self.S.handle, self.bi, self.bj
 
-    def _install_product(self):
-        """Installs the compiled product as the MATOP_MULT of S (one rank) or of its diagonal
-        block (several: PETSc's MPISBAIJ product calls the diagonal block's); returns the
-        matrix's handle, or None where nothing was installed (an empty block, all slots taken)."""
-        from . import cells
-
-        ctypes, lib, _, _ = _petsc_library()
+    def _install_product(self) -> CompiledProduct | None:
+        """The compiled product as the MATOP_MULT of S (one rank) or of its diagonal block
+        (several: PETSc's MPISBAIJ product calls the diagonal block's); None where nothing was
+        installed."""
         handle, bi, bj = self._product_target()
-        if int(bi[-1]) == 0:
-            return None
-        module = cells.compiled()
-        ffi = module.ffi
-        _sbaij_api(module)
-        h = ctypes.c_void_p(handle)
-        original = ctypes.c_void_p()
-        if lib.MatGetOperation(h, _MATOP_MULT, ctypes.byref(original)) or not original.value:
-            return None
-        if not self._register_product(module, handle, bi, bj, original.value):
-            return None
-        mult = int(ffi.cast("uintptr_t", ffi.addressof(module.lib, "sbaij_mult")))
-        if lib.MatSetOperation(h, _MATOP_MULT, ctypes.c_void_p(mult)):
-            module.lib.sbaij_forget(ffi.cast("void*", handle))
-            return None
-        self._original_product = original.value
-        import weakref
-
-        self._forget = weakref.finalize(self, module.lib.sbaij_forget, ffi.cast("void*", handle))
-        return handle
-
-    def _register_product(self, module, handle: int, bi, bj, original: int) -> bool:
-        """(Re-)registers the matrix at ``handle`` with its pattern and the current address of
-        its values (where PETSc keeps them: fixed while the pattern is)."""
-        ctypes, lib, _, _ = _petsc_library()
-        h = ctypes.c_void_p(handle)
-        v = ctypes.POINTER(ctypes.c_double)()
-        if lib.MatSeqSBAIJGetArray(h, ctypes.byref(v)):
-            return False
-        address = ctypes.cast(v, ctypes.c_void_p).value
-        lib.MatSeqSBAIJRestoreArray(h, ctypes.byref(v))
-        if not address:
-            return False
-        ffi = module.ffi
-        return module.lib.sbaij_register(ffi.cast("void*", handle), (len(bi) - 1), self.bs,
-                                         ffi.cast("int32_t*", bi.ctypes.data), ffi.cast("int32_t*", bj.ctypes.data),
-                                         ffi.cast("double*", address), ffi.cast("void*", original)) == 0
+        product = CompiledProduct(handle, 1, len(bi) - 1, len(bi) - 1, self.bs, bi, bj)
+        return product if product.installed else None
 
     def _recheck_product(self) -> None:
         """After an assembly of S: its values' address registered anew (should PETSc have moved them)."""
-        if self._product is None:
-            return
-        from . import cells
-
-        handle, bi, bj = self._product_target()
-        if not self._register_product(cells.compiled(), handle, bi, bj, self._original_product):
-            # (cannot happen while the pattern is fixed) PETSc's product back
-            ctypes, lib, _, _ = _petsc_library()
-            lib.MatSetOperation(ctypes.c_void_p(handle), _MATOP_MULT, ctypes.c_void_p(self._original_product))
-            self._product = None
+        if self._product is not None:
+            self._product.recheck()
 
     @staticmethod
     def _upper_blocks(parts, bs: int, first_block: int, chunk: int = 4096):
@@ -544,7 +618,7 @@ class SymmetricBlockOperator:
 
     def destroy(self) -> None:
         if self._product is not None:
-            self._forget()  # (once: the registration is gone before S is)
+            self._product.forget()  # (before S is gone)
             self._product = None
         self.S.destroy()
         if self._split is not None:

@@ -815,16 +815,9 @@ def test_the_compiled_polar_iteration_is_the_svd_rotation_where_it_answers():
     assert np.abs(R[fair] - amg._nearest_rotations(H[fair])).max() < 1e-13
 
 
-@pytest.mark.parametrize("compiled, d", [(True, 3), (False, 3), (True, 2)], ids=["compiled", "numpy", "plane"])
-def test_the_corotated_prolongator_is_the_built_one_turned_node_by_node(compiled, d, monkeypatch):
-    """The finest prolongator of the block's GAMG hierarchy (3D, and plane strain), turned by a
-    rotation a node, is diag(R_i) P⁰ to round-off, on one rank and several (the off-diagonal
-    block too), and turned back by the identity it is P⁰ again, bit for bit: the rotation acts
-    on the values kept."""
-    from dolfinx_corot.assembly import amg
-
-    if not compiled:
-        monkeypatch.setattr(amg, "_compiled", lambda: None)
+def _amg_solved(d: int):
+    """The cantilever block (d = 3) or plane-strain strip (d = 2) with its iterative system after
+    one solve (a GAMG hierarchy built)."""
     if d == 3:
         sc = _cantilever_block((12, 2, 2))
     else:
@@ -836,6 +829,28 @@ def test_the_corotated_prolongator_is_the_built_one_turned_node_by_node(compiled
     system.residual(0.0)
     system.jacobian()
     system.solve()
+    return system
+
+
+def _nodal_rotations(rng, n: int, d: int) -> np.ndarray:
+    """n random rotations (n, d, d)."""
+    if d == 2:
+        angle = rng.uniform(-3.0, 3.0, size=n)
+        return np.stack([np.stack([np.cos(angle), -np.sin(angle)], -1), np.stack([np.sin(angle), np.cos(angle)], -1)], 1)
+    return np.array([_rotation(rng.normal(size=3), rng.uniform(0.0, 3.0)) for _ in range(n)])
+
+
+@pytest.mark.parametrize("compiled, d", [(True, 3), (False, 3), (True, 2)], ids=["compiled", "numpy", "plane"])
+def test_the_corotated_prolongator_is_the_built_one_turned_node_by_node(compiled, d, monkeypatch):
+    """The finest prolongator of the block's GAMG hierarchy (3D, and plane strain), turned by a
+    rotation a node, is diag(R_i) P⁰ to round-off, on one rank and several (the off-diagonal
+    block too), and turned back by the identity it is P⁰ again, bit for bit: the rotation acts
+    on the values kept."""
+    from dolfinx_corot.assembly import amg
+
+    if not compiled:
+        monkeypatch.setattr(amg, "_compiled", lambda: None)
+    system = _amg_solved(d)
     pc = system.linear.ksp.getPC()
     assert pc.getMGLevels() >= 2
     prolongator = amg.CorotatedProlongator(pc, d)
@@ -843,10 +858,7 @@ def test_the_corotated_prolongator_is_the_built_one_turned_node_by_node(compiled
     P0 = P.convert("dense", PETSc.Mat()).getDenseArray().copy()
     n = system.A.getLocalSize()[0] // d
     rng = np.random.default_rng(comm.rank)
-    R = np.array([_rotation(rng.normal(size=3), rng.uniform(0.0, 3.0)) for _ in range(n)])
-    if d == 2:
-        angle = rng.uniform(-3.0, 3.0, size=n)
-        R = np.stack([np.stack([np.cos(angle), -np.sin(angle)], -1), np.stack([np.sin(angle), np.cos(angle)], -1)], 1)
+    R = _nodal_rotations(rng, n, d)
     prolongator.rotate(R)
     P1 = P.convert("dense", PETSc.Mat()).getDenseArray()
     expected = np.einsum("nab,nbk->nak", R, P0.reshape(n, d, -1)).reshape(P0.shape)
@@ -867,17 +879,7 @@ def test_the_restriction_by_the_nodal_loop_is_petsc_s_transpose_product_to_the_l
     own again once it is restored."""
     from dolfinx_corot.assembly import amg, petsc
 
-    if d == 3:
-        sc = _cantilever_block((12, 2, 2))
-    else:
-        sc = dc.Scene()
-        b = sc.add_solid(_rectangle(24, 4, True), material=dc.NeoHookean(E, 0.3), degree=1)
-        sc.fix(b, "left")
-        sc.load(b, "right", traction=(0.0, -1.0))
-    system = make_system(sc.model, solver="iterative")
-    system.residual(0.0)
-    system.jacobian()
-    system.solve()
+    system = _amg_solved(d)
     pc = system.linear.ksp.getPC()
     prolongator = amg.CorotatedProlongator(pc, d)
     P = prolongator.P
@@ -896,10 +898,7 @@ def test_the_restriction_by_the_nodal_loop_is_petsc_s_transpose_product_to_the_l
         return np.array_equal(ours.array_r, theirs.array_r)
 
     assert same()
-    R = np.array([_rotation(rng.normal(size=3), rng.uniform(0.0, 3.0)) for _ in range(n)])
-    if d == 2:
-        angle = rng.uniform(-3.0, 3.0, size=n)
-        R = np.stack([np.stack([np.cos(angle), -np.sin(angle)], -1), np.stack([np.sin(angle), np.cos(angle)], -1)], 1)
+    R = _nodal_rotations(rng, n, d)
     prolongator.rotate(R)
     assert same()
     ctypes, lib, _, _ = petsc._petsc_library()

@@ -876,7 +876,8 @@ def test_the_restriction_by_the_nodal_loop_is_petsc_s_transpose_product_to_the_l
     nodes (the rows of a node share their columns; installed as the matrix's
     MATOP_MULT_TRANSPOSE on one rank, PETSc's MPIAIJ product on several): PETSc's product
     (of a copy of P) to the last bit, before and after the prolongator is turned, and PETSc's
-    own again once it is restored."""
+    own again once it is restored (the system's own prolongator installed the loop on P before
+    this second one did)."""
     from dolfinx_corot.assembly import amg, petsc
 
     system = _amg_solved(d)
@@ -907,6 +908,9 @@ def test_the_restriction_by_the_nodal_loop_is_petsc_s_transpose_product_to_the_l
         f = ctypes.c_void_p()
         assert lib.MatGetOperation(ctypes.c_void_p(product.handle), petsc._MATOP_MULT_TRANSPOSE, ctypes.byref(f)) == 0
         assert f.value == product.original and not product.installed
+        # PETSc's own, although the system's prolongator had installed the loop on P first
+        module = product.module
+        assert f.value != int(module.ffi.cast("uintptr_t", module.ffi.addressof(module.lib, "nodal_mult_transpose")))
     assert same()
     petsc.destroy(r, ours, theirs)
     system.destroy()

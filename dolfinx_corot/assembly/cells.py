@@ -755,6 +755,9 @@ typedef struct
 } dc_product_t;
 static dc_product_t dc_products[DC_PRODUCT_SLOTS];
 
+int sbaij_mult(void* mat, void* x, void* y);
+int nodal_mult_transpose(void* mat, void* x, void* y);
+
 void product_api(void* get_read, void* restore_read, void* get_write, void* restore_write, void* block_size)
 {
   dc_block_size = (int (*)(void*, int32_t*))block_size;
@@ -782,9 +785,10 @@ int64_t product_register(void* mat, int64_t token, int64_t kind, int64_t n, int6
     return -1;
   dc_product_t e = {mat, token, kind, n, ncols, bs, ia, ja, v};
   dc_products[slot] = e;
-  if (kind == 1 && bs >= 2 && bs <= 3)
+  /* (never one of these loops: a matrix registered twice would send itself to itself) */
+  if (kind == 1 && bs >= 2 && bs <= 3 && petsc_op != (void*)sbaij_mult && petsc_op != (void*)nodal_mult_transpose)
     dc_petsc_sbaij_mult[bs] = (dc_mult_t)petsc_op;
-  if (kind == 2)
+  if (kind == 2 && petsc_op != (void*)sbaij_mult && petsc_op != (void*)nodal_mult_transpose)
     dc_petsc_aij_mult_transpose = (dc_mult_t)petsc_op;
   return 0;
 }

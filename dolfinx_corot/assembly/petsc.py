@@ -99,6 +99,7 @@ def _petsc_library():
 _LIBRARY = None
 _MATOP_MULT, _MATOP_MULT_TRANSPOSE = 3, 5  # PETSc 3.18's MatOperation
 _PRODUCT_API = []
+_PETSC_PRODUCTS: dict[tuple[int, int], int] = {}  # PETSc's own operation of each (kind, block size)
 _PRODUCT_TOKENS = iter(range(1, 2 ** 62))
 
 
@@ -146,12 +147,17 @@ class CompiledProduct:
         original = ctypes.c_void_p()
         if lib.MatGetOperation(h, op, ctypes.byref(original)) or not original.value:
             return
+        ffi = module.ffi
+        address = int(ffi.cast("uintptr_t", ffi.addressof(module.lib, name)))
+        if original.value == address:  # installed already (a second owner): PETSc's is the one seen first
+            if (kind, bs) not in _PETSC_PRODUCTS:
+                return
+            original.value = _PETSC_PRODUCTS[kind, bs]
+        _PETSC_PRODUCTS.setdefault((kind, bs), original.value)
         self.original = original.value
         self.token = next(_PRODUCT_TOKENS)
         if not self.register():
             return
-        ffi = module.ffi
-        address = int(ffi.cast("uintptr_t", ffi.addressof(module.lib, name)))
         if lib.MatSetOperation(h, op, ctypes.c_void_p(address)):
             self.forget()
             return

@@ -915,6 +915,91 @@ def test_the_restriction_by_the_nodal_loop_is_petsc_s_transpose_product_to_the_l
     petsc.destroy(r, ours, theirs)
     system.destroy()
 
+
+@pytest.mark.parametrize("d", [3, 2], ids=["block", "plane"])
+def test_the_coarse_levels_multiply_by_nodal_block_copies_while_they_are_current(d):
+    """AMG's operators between the finest and the coarsest level (AIJ with blocks of the
+    rigid-body modes, 6 × 6 in 3D, 3 × 3 in the plane) multiply by an SBAIJ copy (the upper
+    block triangle: CG's tangent is symmetric) installed as their MATOP_MULT: the AIJ product
+    (of a duplicate: PETSc's own) to round-off; once the operator's state has changed, its own
+    product to the last bit, and a new copy at the next solve's check; PETSc's own product back
+    once restored. A linear solve ends on the solution of the hierarchy without copies
+    (``-dc_amg_coarse_blocks false``) to its tolerance."""
+    from dolfinx_corot.assembly import petsc
+
+    def solved():
+        if d == 3:
+            sc = _cantilever_block((24, 4, 4))
+        else:
+            sc = dc.Scene()
+            b = sc.add_solid(_rectangle(96, 16, True), material=dc.NeoHookean(E, 0.3), degree=1)
+            sc.fix(b, "left")
+            sc.load(b, "right", traction=(0.0, -1.0))
+        system = make_system(sc.model, solver="iterative")
+        system.residual(1.0)
+        system.jacobian()
+        system.solve()
+        return system
+
+    system = solved()
+    linear = system.linear
+    pc = linear.ksp.getPC()
+    copies = linear._coarse
+    assert pc.getMGLevels() >= 3 and sorted(copies) == list(range(1, pc.getMGLevels() - 1))
+    module = next(iter(copies.values())).module
+    ours = int(module.ffi.cast("uintptr_t", module.ffi.addressof(module.lib, "copied_mult")))
+    ctypes, lib, _, _ = petsc._petsc_library()
+
+    def operation(A):
+        f = ctypes.c_void_p()
+        assert lib.MatGetOperation(ctypes.c_void_p(A.handle), petsc._MATOP_MULT, ctypes.byref(f)) == 0
+        return f.value
+
+    rng = np.random.default_rng(comm.rank + 3)
+    for level, product in copies.items():
+        A = pc.getMGSmoother(level).getOperators()[0]
+        assert product.installed and product.current(A) and operation(A) == ours
+        assert product.copy.getType() in ("seqsbaij", "mpisbaij") and product.copy.getBlockSize() == 3 * (d - 1)
+        plain = A.duplicate(copy=True)  # a new matrix: PETSc's own product
+        x, y, z = A.createVecRight(), A.createVecLeft(), A.createVecLeft()
+        x.setArray(rng.normal(size=x.getLocalSize()))
+        A.mult(x, y)
+        plain.mult(x, z)
+        assert (y - z).norm() <= 1e-13 * z.norm() and (y - z).norm() > 0.0  # (another order of the sums)
+        A.stateIncrease()  # as after a new Galerkin product into A
+        assert not product.current(A)
+        A.mult(x, y)
+        assert np.array_equal(y.array_r, z.array_r)
+        petsc.destroy(plain, x, y, z)
+    renewed = petsc.coarse_copies(pc, True, dict(copies))
+    assert sorted(renewed) == sorted(copies)
+    for level, product in renewed.items():
+        A = pc.getMGSmoother(level).getOperators()[0]
+        assert product is not copies[level] and product.current(A) and not copies[level].installed
+        own = product.own
+        product.restore()
+        assert operation(A) == own != ours and not product.installed
+    linear._coarse = {}
+    system.destroy()
+
+    solutions = {}
+    for blocks in (True, False):
+        options = PETSc.Options()
+        if not blocks:
+            options["dc_amg_coarse_blocks"] = "false"
+        try:
+            system = solved()
+            assert bool(system.linear._coarse) == blocks
+            # (on several ranks two meshes of one scene may be partitioned apart: global figures)
+            solutions[blocks] = np.array([system.dx.norm(), system.dx.dot(system.b), system.dx.max()[1]])
+            system.destroy()
+        finally:
+            if not blocks:
+                del options["dc_amg_coarse_blocks"]
+    assert np.all(np.abs(solutions[False]) > 0.0)
+    assert np.all(np.abs(solutions[True] - solutions[False]) <= 1e-8 * np.abs(solutions[False]))
+
+
 def test_the_amg_hierarchy_is_kept_from_step_to_step_co_rotated():
     """The cantilever block bent until its end has turned by about 1.2 rad, in 4 steps, CG + AMG:
     with the hierarchy of the first step kept and its finest prolongator co-rotated by the

@@ -733,15 +733,20 @@ void lu_summary(int64_t n, const double* diagonal, const int32_t* piv, double nu
    - y = P^T x of a SeqAIJ matrix whose rows come in groups of bs (a node's) with the same
      columns (AMG's prolongators), as MATOP_MULT_TRANSPOSE: each column's index and each entry
      of y read and written once per node instead of once per row, the rows' contributions added
-     in PETSc's order (MatMultTranspose_SeqAIJ), so the same numbers to the last bit.
-   The pattern is fixed, so the value arrays stay where they are. A matrix that carries the
-   operation but is not registered (its registration forgotten) goes to PETSc's own. */
+     in PETSc's order (MatMultTranspose_SeqAIJ), so the same numbers to the last bit;
+   - y = A x of a matrix by the product of a copy of it in another format (AMG's coarse
+     operators, AIJ with 6 x 6 blocks, by their SBAIJ copies: a fifth of the time), as
+     MATOP_MULT, while A's object state is the one copied (else by A's own product).
+   The pattern is fixed, so the value arrays stay where they are. A matrix that carries one of
+   the first two operations but is not registered (its registration forgotten) goes to PETSc's
+   own; a copied product's own operation is put back before its registration ends. */
 typedef int (*dc_vec_read_t)(void*, const double**);
 typedef int (*dc_vec_write_t)(void*, double**);
 typedef int (*dc_mult_t)(void*, void*, void*);
 static dc_vec_read_t dc_get_read = 0, dc_restore_read = 0;
 static dc_vec_write_t dc_get_write = 0, dc_restore_write = 0;
 static int (*dc_block_size)(void*, int32_t*) = 0;
+static int (*dc_object_state)(void*, int64_t*) = 0;
 static dc_mult_t dc_petsc_sbaij_mult[4] = {0, 0, 0, 0};
 static dc_mult_t dc_petsc_aij_mult_transpose = 0;
 
@@ -752,15 +757,21 @@ typedef struct
   int64_t token, kind, n, ncols, bs; /* kind 1: SBAIJ product (n block rows); 2: AIJ transpose (n rows, ncols) */
   const int32_t *ia, *ja;
   const double* v;
+  void* copy; /* kind 3: the copy, its product, the matrix's own and the state copied */
+  dc_mult_t copy_mult, own_mult;
+  int64_t state;
 } dc_product_t;
 static dc_product_t dc_products[DC_PRODUCT_SLOTS];
 
 int sbaij_mult(void* mat, void* x, void* y);
 int nodal_mult_transpose(void* mat, void* x, void* y);
+int copied_mult(void* mat, void* x, void* y);
 
-void product_api(void* get_read, void* restore_read, void* get_write, void* restore_write, void* block_size)
+void product_api(void* get_read, void* restore_read, void* get_write, void* restore_write, void* block_size,
+                 void* object_state)
 {
   dc_block_size = (int (*)(void*, int32_t*))block_size;
+  dc_object_state = (int (*)(void*, int64_t*))object_state;
   dc_get_read = (dc_vec_read_t)get_read;
   dc_restore_read = (dc_vec_read_t)restore_read;
   dc_get_write = (dc_vec_write_t)get_write;
@@ -783,13 +794,36 @@ int64_t product_register(void* mat, int64_t token, int64_t kind, int64_t n, int6
       slot = s;
   if (slot < 0)
     return -1;
-  dc_product_t e = {mat, token, kind, n, ncols, bs, ia, ja, v};
+  dc_product_t e = {mat, token, kind, n, ncols, bs, ia, ja, v, 0, 0, 0, 0};
   dc_products[slot] = e;
   /* (never one of these loops: a matrix registered twice would send itself to itself) */
   if (kind == 1 && bs >= 2 && bs <= 3 && petsc_op != (void*)sbaij_mult && petsc_op != (void*)nodal_mult_transpose)
     dc_petsc_sbaij_mult[bs] = (dc_mult_t)petsc_op;
   if (kind == 2 && petsc_op != (void*)sbaij_mult && petsc_op != (void*)nodal_mult_transpose)
     dc_petsc_aij_mult_transpose = (dc_mult_t)petsc_op;
+  return 0;
+}
+
+/* kind 3: the product of mat by copy_mult(copy, x, y) while mat's object state is `state`, else
+   by own_mult (mat's own operation); 0, or -1 where all slots are taken */
+int64_t product_register_copy(void* mat, int64_t token, void* copy, void* copy_mult, void* own_mult, int64_t state)
+{
+  if (own_mult == (void*)copied_mult || copy_mult == (void*)copied_mult)
+    return -1;
+  int64_t slot = -1;
+  for (int64_t s = 0; s < DC_PRODUCT_SLOTS; ++s)
+    if (dc_products[s].mat == mat)
+    {
+      slot = s;
+      break;
+    }
+  for (int64_t s = 0; slot < 0 && s < DC_PRODUCT_SLOTS; ++s)
+    if (dc_products[s].mat == 0)
+      slot = s;
+  if (slot < 0)
+    return -1;
+  dc_product_t e = {mat, token, 3, 0, 0, 0, 0, 0, 0, copy, (dc_mult_t)copy_mult, (dc_mult_t)own_mult, state};
+  dc_products[slot] = e;
   return 0;
 }
 
@@ -954,6 +988,19 @@ int sbaij_mult(void* mat, void* x, void* y)
   return dc_restore(x, &px, y, &py);
 }
 
+/* MATOP_MULT of a matrix registered with a copy (kind 3) */
+int copied_mult(void* mat, void* x, void* y)
+{
+  const dc_product_t* e = dc_product(mat, 3);
+  if (!e)
+    return 73; /* (never: the matrix's own operation is back before its registration ends) */
+  int64_t state = -1;
+  int ierr = dc_object_state(mat, &state);
+  if (ierr)
+    return ierr;
+  return state == e->state ? e->copy_mult(e->copy, x, y) : e->own_mult(mat, x, y);
+}
+
 /* MATOP_MULT_TRANSPOSE of a registered SeqAIJ matrix of nodal rows (y: its columns) */
 int nodal_mult_transpose(void* mat, void* x, void* y)
 {
@@ -1008,7 +1055,10 @@ void scaled_band(int64_t n, const int32_t* indptr, const int32_t* indices, const
                  int64_t ku, int64_t ldab, double* ab, double* s);
 void bandwidths(int64_t n, const int32_t* indptr, const int32_t* indices, int64_t* out);
 void lu_summary(int64_t n, const double* diagonal, const int32_t* piv, double null_pivot, int64_t* out);
-void product_api(void* get_read, void* restore_read, void* get_write, void* restore_write, void* block_size);
+void product_api(void* get_read, void* restore_read, void* get_write, void* restore_write, void* block_size,
+                 void* object_state);
+int64_t product_register_copy(void* mat, int64_t token, void* copy, void* copy_mult, void* own_mult, int64_t state);
+int copied_mult(void* mat, void* x, void* y);
 int64_t product_register(void* mat, int64_t token, int64_t kind, int64_t n, int64_t ncols, int64_t bs,
                          const int32_t* ia, const int32_t* ja, const double* v, void* petsc_op);
 void product_forget(void* mat, int64_t token);

@@ -978,7 +978,8 @@ class LinearSolver:
             # the 116 k-dof SVK block against ML (Trilinos) on a BAIJ copy: half the peak memory
             # (384 against 750 MB; ML's hierarchy alone took 318 MB, GAMG's 55 MB); AMG reads
             # the AIJ matrix the tangent is assembled into, CG and the smoothers its upper
-            # triangle in nodal blocks (SymmetricBlockOperator). One sweep instead of PETSc's
+            # triangle in nodal blocks (SymmetricBlockOperator), the coarse levels' products
+            # SBAIJ copies of their operators (coarse_copies). One sweep instead of PETSc's
             # two: 1.3 times the CG iterations at 0.6 of the V-cycle's cost
             self.ksp.setType("cg" if symmetric else "gmres")
             pc.setType("gamg")

@@ -979,6 +979,18 @@ def test_the_coarse_levels_multiply_by_nodal_block_copies_while_they_are_current
         own = product.own
         product.restore()
         assert operation(A) == own != ours and not product.installed
+    # an unsymmetric solve's copies: BAIJ, the AIJ product to round-off
+    for level, product in petsc.coarse_copies(pc, False, {}).items():
+        A = pc.getMGSmoother(level).getOperators()[0]
+        assert product.format == "baij" and product.copy.getType() in ("seqbaij", "mpibaij")
+        plain = A.duplicate(copy=True)
+        x, y, z = A.createVecRight(), A.createVecLeft(), A.createVecLeft()
+        x.setArray(rng.normal(size=x.getLocalSize()))
+        A.mult(x, y)
+        plain.mult(x, z)
+        assert (y - z).norm() <= 1e-13 * z.norm()
+        product.restore()
+        petsc.destroy(plain, x, y, z)
     linear._coarse = {}
     system.destroy()
 

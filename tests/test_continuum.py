@@ -815,18 +815,19 @@ def test_the_compiled_polar_iteration_is_the_svd_rotation_where_it_answers():
     assert np.abs(R[fair] - amg._nearest_rotations(H[fair])).max() < 1e-13
 
 
-def _amg_solved(d: int):
-    """The cantilever block (d = 3) or plane-strain strip (d = 2) with its iterative system after
-    one solve (a GAMG hierarchy built)."""
+def _amg_solved(d: int, refined: int = 1, load: float = 0.0):
+    """The cantilever block (d = 3, 12 × 2 × 2 cells times ``refined``) or plane-strain strip
+    (d = 2, 24 × 4 times ``refined``) with its iterative system after one solve (a GAMG hierarchy
+    built) at the load factor ``load``."""
     if d == 3:
-        sc = _cantilever_block((12, 2, 2))
+        sc = _cantilever_block((12 * refined, 2 * refined, 2 * refined))
     else:
         sc = dc.Scene()
-        b = sc.add_solid(_rectangle(24, 4, True), material=dc.NeoHookean(E, 0.3), degree=1)
+        b = sc.add_solid(_rectangle(24 * refined, 4 * refined, True), material=dc.NeoHookean(E, 0.3), degree=1)
         sc.fix(b, "left")
         sc.load(b, "right", traction=(0.0, -1.0))
     system = make_system(sc.model, solver="iterative")
-    system.residual(0.0)
+    system.residual(load)
     system.jacobian()
     system.solve()
     return system
@@ -927,19 +928,8 @@ def test_the_coarse_levels_multiply_by_nodal_block_copies_while_they_are_current
     (``-dc_amg_coarse_blocks false``) to its tolerance."""
     from dolfinx_corot.assembly import petsc
 
-    def solved():
-        if d == 3:
-            sc = _cantilever_block((24, 4, 4))
-        else:
-            sc = dc.Scene()
-            b = sc.add_solid(_rectangle(96, 16, True), material=dc.NeoHookean(E, 0.3), degree=1)
-            sc.fix(b, "left")
-            sc.load(b, "right", traction=(0.0, -1.0))
-        system = make_system(sc.model, solver="iterative")
-        system.residual(1.0)
-        system.jacobian()
-        system.solve()
-        return system
+    def solved():  # (three levels at least)
+        return _amg_solved(d, 2 if d == 3 else 4, load=1.0)
 
     system = solved()
     linear = system.linear

@@ -778,20 +778,23 @@ void product_api(void* get_read, void* restore_read, void* get_write, void* rest
   dc_restore_write = (dc_vec_write_t)restore_write;
 }
 
+/* the slot of mat's registration, else a free one, else -1 */
+static int64_t dc_slot(void* mat)
+{
+  for (int64_t s = 0; s < DC_PRODUCT_SLOTS; ++s)
+    if (dc_products[s].mat == mat)
+      return s;
+  for (int64_t s = 0; s < DC_PRODUCT_SLOTS; ++s)
+    if (dc_products[s].mat == 0)
+      return s;
+  return -1;
+}
+
 /* 0, or -1 where all slots are taken; petsc_op: PETSc's own operation (the fallback) */
 int64_t product_register(void* mat, int64_t token, int64_t kind, int64_t n, int64_t ncols, int64_t bs,
                          const int32_t* ia, const int32_t* ja, const double* v, void* petsc_op)
 {
-  int64_t slot = -1;
-  for (int64_t s = 0; s < DC_PRODUCT_SLOTS; ++s)
-    if (dc_products[s].mat == mat)
-    {
-      slot = s;
-      break;
-    }
-  for (int64_t s = 0; slot < 0 && s < DC_PRODUCT_SLOTS; ++s)
-    if (dc_products[s].mat == 0)
-      slot = s;
+  const int64_t slot = dc_slot(mat);
   if (slot < 0)
     return -1;
   dc_product_t e = {mat, token, kind, n, ncols, bs, ia, ja, v, 0, 0, 0, 0};
@@ -810,16 +813,7 @@ int64_t product_register_copy(void* mat, int64_t token, void* copy, void* copy_m
 {
   if (own_mult == (void*)copied_mult || copy_mult == (void*)copied_mult)
     return -1;
-  int64_t slot = -1;
-  for (int64_t s = 0; s < DC_PRODUCT_SLOTS; ++s)
-    if (dc_products[s].mat == mat)
-    {
-      slot = s;
-      break;
-    }
-  for (int64_t s = 0; slot < 0 && s < DC_PRODUCT_SLOTS; ++s)
-    if (dc_products[s].mat == 0)
-      slot = s;
+  const int64_t slot = dc_slot(mat);
   if (slot < 0)
     return -1;
   dc_product_t e = {mat, token, 3, 0, 0, 0, 0, 0, 0, copy, (dc_mult_t)copy_mult, (dc_mult_t)own_mult, state};

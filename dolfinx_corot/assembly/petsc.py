@@ -214,9 +214,9 @@ class CompiledProduct:
 
 class CopiedProduct:
     """The product of ``A`` by that of a copy of it in the nodal-block format ``fmt`` ('sbaij':
-    its upper block triangle, where A is flagged symmetric, else 'baij'), installed as A's MATOP_MULT (the
-    compiled ``copied_mult`` of :mod:`dolfinx_corot.assembly.cells`): it serves while A's object
-    state is the one copied, A's own product after any change of A. For AMG's coarse operators,
+    its upper block triangle, where A is flagged symmetric, else 'baij'), installed as A's
+    MATOP_MULT (the compiled ``copied_mult`` of :mod:`dolfinx_corot.assembly.cells`): it serves
+    while A's object state is the one copied, A's own product after any change of A. For AMG's coarse operators,
     which PETSc keeps as AIJ with 6 × 6 blocks (the rigid-body modes) whose I-nodes hold five
     rows: on the 116 k-dof block's third level (3876 rows, 672 k entries) 1.08 ms a product
     against 0.20 ms by SBAIJ and 0.33 ms by BAIJ. The numbers differ from A's by round-off (the

@@ -297,8 +297,6 @@ def coarse_copies(pc: PETSc.PC, symmetric: bool, kept: dict[int, CopiedProduct])
         product = kept.pop(level, None)
         current = product is not None and product.current(A)
         if comm.size > 1:  # (the conversion is collective)
-            from mpi4py import MPI
-
             current = comm.allreduce(current, op=MPI.LAND)
         if current:
             copies[level] = product

@@ -52,9 +52,9 @@ bench: setup
 	$(PY) benchmarks/pullout_snap.py               # the pull-out's snap converged: about 8 minutes
 	$(PY) benchmarks/beam_kernels.py               # the beams' C kernels against numba's, 10⁵ elements
 	$(PY) benchmarks/frame3d.py --sizes 7 15 32   # 10³, 10⁴, 10⁵ elements: about 20 minutes
-	$(PY) benchmarks/block3d.py                    # 116 k dofs SVK block: about 10 s
+	$(PY) benchmarks/block3d.py                    # 116 k dofs SVK block: about 9 s
 	mpirun -n 2 $(PY) benchmarks/block3d.py
-	$(PY) benchmarks/block3d.py --mesh 320 32 32   # 10⁶ dofs: about 2 minutes, 2.9 GB
+	$(PY) benchmarks/block3d.py --mesh 320 32 32   # 10⁶ dofs: under 2 minutes, 2.9 GB
 	mpirun -n 2 $(PY) benchmarks/block3d.py --mesh 320 32 32
 	$(PY) benchmarks/contact_search.py             # 10⁴, 10⁵, 10⁶ slaves and segments
 	$(PY) benchmarks/contact_effects.py            # an idle interface's cost

@@ -872,48 +872,67 @@ def test_the_corotated_prolongator_is_the_built_one_turned_node_by_node(compiled
 
 
 @pytest.mark.parametrize("d", [3, 2], ids=["block", "plane"])
-def test_the_restriction_by_the_nodal_loop_is_petsc_s_transpose_product_to_the_last_bit(d):
-    """The V-cycle's restriction Pᵀ r with the kept finest prolongator is a compiled loop over its
-    nodes (the rows of a node share their columns; installed as the matrix's
-    MATOP_MULT_TRANSPOSE on one rank, PETSc's MPIAIJ product on several): PETSc's product
-    (of a copy of P) to the last bit, before and after the prolongator is turned, and PETSc's
-    own again once it is restored (the system's own prolongator installed the loop on P before
-    this second one did)."""
+def test_the_transfers_by_the_nodal_loops_are_petsc_s_products_to_the_last_bit(d):
+    """The V-cycle's restriction Pᵀr and prolongation x + Pe with the kept finest prolongator are
+    compiled loops over its nodes (the rows of a node share their columns; installed as the
+    matrix's MATOP_MULT_TRANSPOSE and MATOP_MULT_ADD on one rank, PETSc's MPIAIJ products on
+    several): PETSc's products (of a copy of P: its I-node product for the prolongation) to the
+    last bit, the prolongation into another vector and in place, before and after the
+    prolongator is turned, and PETSc's own again once restored (the system's own prolongator
+    installed the loops on P before this second one did)."""
     from dolfinx_corot.assembly import amg, petsc
 
     system = _amg_solved(d)
     pc = system.linear.ksp.getPC()
     prolongator = amg.CorotatedProlongator(pc, d)
     P = prolongator.P
-    products = prolongator.transpose_products
-    assert len(products) == (1 if comm.size == 1 else 0) and all(p.installed for p in products)
+    products = prolongator.transfer_products
+    assert sorted(p.kind for p in products) == ([2, 4] if comm.size == 1 else []) and all(p.installed for p in products)
     n = system.A.getLocalSize()[0] // d
     rng = np.random.default_rng(comm.rank + 7)
     r, ours, theirs = P.createVecLeft(), P.createVecRight(), P.createVecRight()
+    e, fine_ours, fine_theirs = P.createVecRight(), P.createVecLeft(), P.createVecLeft()
+    ctypes, lib, _, _ = petsc._petsc_library()
+
+    def operation(product):
+        f = ctypes.c_void_p()
+        op, _ = petsc.CompiledProduct._FUNCTIONS[product.kind]
+        assert lib.MatGetOperation(ctypes.c_void_p(product.handle), op, ctypes.byref(f)) == 0
+        return f.value
 
     def same():
-        copy = P.duplicate(copy=True)  # a new matrix: PETSc's product
+        copy = P.duplicate(copy=True)  # a new matrix: PETSc's products
         r.setArray(rng.normal(size=r.getLocalSize()))
+        e.setArray(rng.normal(size=e.getLocalSize()))
         P.multTranspose(r, ours)
         copy.multTranspose(r, theirs)
+        equal = [np.array_equal(ours.array_r, theirs.array_r)]
+        P.multAdd(e, r, fine_ours)
+        copy.multAdd(e, r, fine_theirs)
+        equal.append(np.array_equal(fine_ours.array_r, fine_theirs.array_r))
+        P.multAdd(e, fine_ours, fine_ours)  # (in place, as the V-cycle's interpolation)
+        copy.multAdd(e, fine_theirs, fine_theirs)
+        equal.append(np.array_equal(fine_ours.array_r, fine_theirs.array_r))
         copy.destroy()
-        return np.array_equal(ours.array_r, theirs.array_r)
+        return all(equal)
 
+    module = petsc._compiled_cells()
+    for product in products:
+        name = petsc.CompiledProduct._FUNCTIONS[product.kind][1]
+        assert operation(product) == int(module.ffi.cast("uintptr_t", module.ffi.addressof(module.lib, name)))
     assert same()
     R = _nodal_rotations(rng, n, d)
     prolongator.rotate(R)
     assert same()
-    ctypes, lib, _, _ = petsc._petsc_library()
     for product in products:
         product.restore()
-        f = ctypes.c_void_p()
-        assert lib.MatGetOperation(ctypes.c_void_p(product.handle), petsc._MATOP_MULT_TRANSPOSE, ctypes.byref(f)) == 0
-        assert f.value == product.original and not product.installed
+        f = operation(product)
+        assert f == product.original and not product.installed
         # PETSc's own, although the system's prolongator had installed the loop on P first
-        module = product.module
-        assert f.value != int(module.ffi.cast("uintptr_t", module.ffi.addressof(module.lib, "nodal_mult_transpose")))
+        name = petsc.CompiledProduct._FUNCTIONS[product.kind][1]
+        assert f != int(module.ffi.cast("uintptr_t", module.ffi.addressof(module.lib, name)))
     assert same()
-    petsc.destroy(r, ours, theirs)
+    petsc.destroy(r, ours, theirs, e, fine_ours, fine_theirs)
     system.destroy()
 
 
@@ -961,11 +980,26 @@ def test_the_coarse_levels_multiply_by_nodal_block_copies_while_they_are_current
             assert 0.0 < (y - z).norm() <= 1e-13 * z.norm()
         petsc.destroy(plain, x, y, z)
 
+    sbaij = int(module.ffi.cast("uintptr_t", module.ffi.addressof(module.lib, "sbaij_mult")))
     for level, product in copies.items():
         A = pc.getMGSmoother(level).getOperators()[0]
         assert product.installed and product.current(A) and operation(A) == ours
         assert product.copy.getType() in ("seqsbaij", "mpisbaij") and product.copy.getBlockSize() == 3 * (d - 1)
         against_petsc(A)
+        # the copy's product by the compiled loop (on several ranks its diagonal block's): PETSc's
+        # SBAIJ product (MatMult_SeqSBAIJ_6 or _3) to the last bit
+        compiled = product.compiled
+        assert compiled is not None and compiled.installed and compiled.bs == 3 * (d - 1)
+        target = product.copy if comm.size == 1 else product.copy.getDiagonalBlock()
+        assert operation(target) == sbaij
+        x, y, z = A.createVecRight(), A.createVecLeft(), A.createVecLeft()
+        x.setArray(rng.normal(size=x.getLocalSize()))
+        A.mult(x, y)
+        compiled.restore()
+        assert operation(target) == compiled.original != sbaij
+        A.mult(x, z)
+        assert np.array_equal(y.array_r, z.array_r)
+        petsc.destroy(x, y, z)
         A.stateIncrease()  # as after a new Galerkin product into A
         assert not product.current(A)
         against_petsc(A, exact=True)

@@ -936,6 +936,61 @@ def test_the_transfers_by_the_nodal_loops_are_petsc_s_products_to_the_last_bit(d
     system.destroy()
 
 
+def test_the_tangent_s_diagonal_is_the_kept_one_while_the_tangent_is_current():
+    """Where the tangent is assembled into the solver's upper block triangle alone (the compiled
+    assembly: 4 000 cells a rank at least), A's MATOP_GET_DIAGONAL (which the finest Jacobi smoother
+    reads once a solve) hands back the diagonal the assembly kept: PETSc's own diagonal of A (of
+    a duplicate) to the last bit after each new tangent; once A has changed otherwise, A's own
+    operation (the changed entry); PETSc's operation back once restored. A second one on the
+    same matrix is not installed."""
+    from dolfinx_corot.assembly import cells, petsc
+
+    system = make_system(_cantilever_block((64, 12, 12)).model, solver="iterative")  # (4 608 cells a rank on two)
+    system.residual(0.5)
+    system.jacobian()
+    system.solve()
+    operator = system._upper_operator()
+    assert operator is not None
+    kept = operator._kept
+    A = system.A
+    ctypes, lib, _, _ = petsc._petsc_library()
+    module = cells.compiled()
+    ours = int(module.ffi.cast("uintptr_t", module.ffi.addressof(module.lib, "kept_diagonal")))
+
+    def operation():
+        f = ctypes.c_void_p()
+        assert lib.MatGetOperation(ctypes.c_void_p(A.handle), petsc._MATOP_GET_DIAGONAL, ctypes.byref(f)) == 0
+        return f.value
+
+    def petsc_diagonal():
+        plain = A.duplicate(copy=True)  # (a new matrix: PETSc's operation)
+        d = plain.getDiagonal()
+        values = d.array_r.copy()
+        petsc.destroy(plain, d)
+        return values
+
+    assert kept is not None and kept.installed and operation() == ours
+    assert not petsc.KeptDiagonal(A).installed  # (a second one would call itself as A's own)
+    for load in (0.5, 1.0):
+        system.residual(load)
+        system.jacobian()
+        assert kept.values is not None and np.array_equal(kept.values, operator.diagonal())
+        d = A.getDiagonal()
+        assert np.array_equal(d.array_r, petsc_diagonal()) and np.all(d.array_r > 0.0)
+        d.destroy()
+        system.solve()
+    first = A.getOwnershipRange()[0]
+    A.setValue(first, first, 12345.0)
+    A.assemble()
+    d = A.getDiagonal()
+    assert d.array_r[0] == 12345.0 and np.array_equal(d.array_r, petsc_diagonal())
+    d.destroy()
+    own = kept.own
+    kept.restore()
+    assert operation() == own != ours and not kept.installed
+    system.destroy()
+
+
 @pytest.mark.parametrize("d", [3, 2], ids=["block", "plane"])
 def test_the_coarse_levels_multiply_by_nodal_block_copies_while_they_are_current(d):
     """AMG's operators between the finest and the coarsest level (AIJ with blocks of the

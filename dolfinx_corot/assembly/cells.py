@@ -738,6 +738,8 @@ void lu_summary(int64_t n, const double* diagonal, const int32_t* piv, double nu
      in PETSc's order (MatMultTranspose_SeqAIJ), so the same numbers to the last bit;
    - y = z + P x of the same matrices, as MATOP_MULT_ADD (the V-cycle's prolongation), in the
      order of PETSc's I-node product, which serves them;
+   - the diagonal of a matrix from a kept copy, as MATOP_GET_DIAGONAL, while the matrix's object
+     state is the one kept (the tangent's, for the Jacobi smoother, which reads it once a solve);
    - y = A x of a matrix by the product of a copy of it in another format (AMG's coarse
      operators, AIJ with 6 x 6 blocks, by their SBAIJ copies: a fifth of the time), as
      MATOP_MULT, while A's object state is the one copied (else by A's own product).
@@ -761,7 +763,7 @@ typedef struct
 {
   void* mat;
   int64_t token, kind, n, ncols, bs; /* kind 1: SBAIJ product (n block rows); 2: AIJ transpose (n rows,
-                                        ncols); 4: AIJ product added (n rows, ncols) */
+                                        ncols); 4: AIJ product added (n rows, ncols); 5: kept diagonal (n) */
   const int32_t *ia, *ja;
   const double* v;
   void* copy; /* kind 3: the copy, its product, the matrix's own and the state copied */
@@ -774,6 +776,7 @@ int sbaij_mult(void* mat, void* x, void* y);
 int nodal_mult_transpose(void* mat, void* x, void* y);
 int nodal_mult_add(void* mat, void* x, void* z, void* y);
 int copied_mult(void* mat, void* x, void* y);
+int kept_diagonal(void* mat, void* d);
 
 void product_api(void* get_read, void* restore_read, void* get_write, void* restore_write, void* block_size,
                  void* object_state, void* get_array, void* restore_array)
@@ -837,6 +840,19 @@ int64_t product_register_copy(void* mat, int64_t token, void* copy, void* copy_m
   if (slot < 0)
     return -1;
   dc_product_t e = {mat, token, 3, 0, 0, 0, 0, 0, 0, copy, (dc_mult_t)copy_mult, (dc_mult_t)own_mult, state};
+  dc_products[slot] = e;
+  return 0;
+}
+
+/* kind 5: the diagonal of mat from a kept copy (n values at v) while mat's object state is
+   `state`, else by own (mat's own operation, never kept_diagonal: the caller checks, as cffi's
+   address of a function is its wrapper's); 0, or -1 where all slots are taken */
+int64_t product_register_diagonal(void* mat, int64_t token, int64_t n, const double* v, void* own, int64_t state)
+{
+  const int64_t slot = dc_slot(mat);
+  if (slot < 0)
+    return -1;
+  dc_product_t e = {mat, token, 5, n, 0, 0, 0, 0, v, 0, 0, (dc_mult_t)own, state};
   dc_products[slot] = e;
   return 0;
 }
@@ -1141,6 +1157,25 @@ int copied_mult(void* mat, void* x, void* y)
   return state == e->state ? e->copy_mult(e->copy, x, y) : e->own_mult(mat, x, y);
 }
 
+/* MATOP_GET_DIAGONAL of a matrix registered with a kept diagonal (kind 5) */
+int kept_diagonal(void* mat, void* d)
+{
+  const dc_product_t* e = dc_product(mat, 5);
+  if (!e)
+    return 73; /* (never: the matrix's own operation is back before its registration ends) */
+  int64_t state = -1;
+  int ierr = dc_object_state(mat, &state);
+  if (ierr)
+    return ierr;
+  if (state != e->state)
+    return ((int (*)(void*, void*))e->own_mult)(mat, d);
+  double* pd;
+  if ((ierr = dc_get_write(d, &pd)))
+    return ierr;
+  memcpy(pd, e->v, sizeof(double) * e->n);
+  return dc_restore_write(d, &pd);
+}
+
 /* MATOP_MULT_TRANSPOSE of a registered SeqAIJ matrix of nodal rows (y: its columns) */
 int nodal_mult_transpose(void* mat, void* x, void* y)
 {
@@ -1235,6 +1270,8 @@ void product_api(void* get_read, void* restore_read, void* get_write, void* rest
                  void* object_state, void* get_array, void* restore_array);
 int64_t product_register_copy(void* mat, int64_t token, void* copy, void* copy_mult, void* own_mult, int64_t state);
 int copied_mult(void* mat, void* x, void* y);
+int64_t product_register_diagonal(void* mat, int64_t token, int64_t n, const double* v, void* own, int64_t state);
+int kept_diagonal(void* mat, void* d);
 int64_t product_register(void* mat, int64_t token, int64_t kind, int64_t n, int64_t ncols, int64_t bs,
                          const int32_t* ia, const int32_t* ja, const double* v, void* petsc_op);
 void product_forget(void* mat, int64_t token);

@@ -99,7 +99,7 @@ def _petsc_library():
 
 
 _LIBRARY = None
-_MATOP_MULT, _MATOP_MULT_ADD, _MATOP_MULT_TRANSPOSE = 3, 4, 5  # PETSc 3.18's MatOperation
+_MATOP_MULT, _MATOP_MULT_ADD, _MATOP_MULT_TRANSPOSE, _MATOP_GET_DIAGONAL = 3, 4, 5, 17  # PETSc 3.18's MatOperation
 _PRODUCT_API = []
 _PETSC_PRODUCTS: dict[tuple[int, int], int] = {}  # PETSc's own operation of each (kind, block size)
 _PRODUCT_TOKENS = iter(range(1, 2 ** 62))
@@ -253,6 +253,8 @@ class CopiedProduct:
             return
         ffi = module.ffi
         address = int(ffi.cast("uintptr_t", ffi.addressof(module.lib, "copied_mult")))
+        if own.value == address:  # (another copy serves A: A's own would be this one)
+            return
         self.own = own.value
         self.token = next(_PRODUCT_TOKENS)
         cast = ffi.cast
@@ -298,6 +300,72 @@ class CopiedProduct:
         if self.installed:
             self._finalizer()
             self.installed = False
+
+
+class KeptDiagonal:
+    """A's diagonal (its MATOP_GET_DIAGONAL, the compiled ``kept_diagonal`` of
+    :mod:`dolfinx_corot.assembly.cells`) from a copy kept by :meth:`keep` while A's object state is
+    the one kept, by A's own operation otherwise (before the first :meth:`keep`, after any change
+    of A). For the tangent, whose diagonal the assembly makes anyway and which the Jacobi
+    smoother of AMG's finest level reads once a solve: PETSc's loop reads A's values at the
+    diagonal's places, about 10 ms on the 116 k-dof block (2 % of the run). ``installed`` is False
+    where nothing was (no slot); :meth:`restore` puts A's own operation back (also when the object
+    is collected)."""
+
+    def __init__(self, A: PETSc.Mat):
+        import weakref
+
+        self.A = A
+        self.installed = False
+        self.values = None
+        self.module = module = _compiled_cells()
+        _product_api(module)
+        ctypes, lib, _, _ = _petsc_library()
+        ffi = module.ffi
+        address = int(ffi.cast("uintptr_t", ffi.addressof(module.lib, "kept_diagonal")))
+        own = ctypes.c_void_p()
+        if lib.MatGetOperation(ctypes.c_void_p(A.handle), _MATOP_GET_DIAGONAL, ctypes.byref(own)) or not own.value \
+                or own.value == address:  # (another one serves A: A's own would be this one)
+            return
+        self.own = own.value
+        self.token = next(_PRODUCT_TOKENS)
+        if not self._register(None, -1):  # (nothing kept yet: A's own operation serves)
+            return
+        if lib.MatSetOperation(ctypes.c_void_p(A.handle), _MATOP_GET_DIAGONAL, ctypes.c_void_p(address)):
+            module.lib.product_forget(ffi.cast("void*", A.handle), self.token)
+            return
+        self.installed = True
+        self._finalizer = weakref.finalize(self, _restore_diagonal, module, A, self.own, self.token)
+
+    def _register(self, values: np.ndarray | None, state: int) -> bool:
+        ffi, lib = self.module.ffi, self.module.lib
+        n, address = (0, ffi.NULL) if values is None else (len(values), ffi.cast("double*", values.ctypes.data))
+        return lib.product_register_diagonal(ffi.cast("void*", self.A.handle), self.token, n, address,
+                                             ffi.cast("void*", self.own), state) == 0
+
+    def keep(self, diagonal: np.ndarray) -> None:
+        """A's diagonal is now ``diagonal`` (its owned rows), until A changes."""
+        if not self.installed:
+            return
+        values = np.ascontiguousarray(diagonal, dtype=np.float64)
+        if len(values) != self.A.getLocalSize()[0]:
+            self._register(None, -1)
+            return
+        self.values = values  # (alive while registered)
+        self._register(values, self.A.stateGet())
+
+    def restore(self) -> None:
+        """A's own operation back."""
+        if self.installed:
+            self._finalizer()
+            self.installed = False
+
+
+def _restore_diagonal(module, A: PETSc.Mat, own: int, token: int) -> None:
+    if not PETSc.Sys.isFinalized():
+        ctypes, lib, _, _ = _petsc_library()
+        lib.MatSetOperation(ctypes.c_void_p(A.handle), _MATOP_GET_DIAGONAL, ctypes.c_void_p(own))
+    module.lib.product_forget(module.ffi.cast("void*", A.handle), token)
 
 
 def _restore_copied(module, A: PETSc.Mat, copy: PETSc.Mat, own: int, token: int,
@@ -515,12 +583,22 @@ class SymmetricBlockOperator:
             S.setLGMap(*A.getLGMap())  # the rows of ghost nodes go to their owners by local index
             self._off_values = np.zeros((len(self._split[2]), bs * bs))
             self._diagonal_vec = S.createVecLeft()
-        # S's product by the compiled loop (cells.sbaij_mult): PETSc's numbers, 0.75-0.85 of its time
+        # S's product by the compiled loop (cells.sbaij_mult): PETSc's numbers, 0.65-0.8 of its time
         self._product = None
         if (compiled and bs in (2, 3) and np.dtype(PETSc.IntType) == np.int32
                 and (self.serial or self._split is not None)
                 and PETSc.Options().getBool("dc_sbaij_product", True)):
             self._product = self._install_product()
+        # A's diagonal from the one kept by the assembly (KeptDiagonal; ``-dc_kept_diagonal false``:
+        # PETSc's)
+        self._kept = None
+        if compiled and (self.serial or self._split is not None) and PETSc.Options().getBool("dc_kept_diagonal", True):
+            self._kept = KeptDiagonal(A)
+
+    def _keep_diagonal(self) -> None:
+        """A's diagonal is the tangent's (``self._diagonal``) at its present state."""
+        if self._kept is not None:
+            self._kept.keep(self._diagonal)
 
     def _product_target(self):
         """(the SeqSBAIJ matrix whose product is compiled: S or its diagonal block, its block CSR)."""
@@ -659,6 +737,7 @@ class SymmetricBlockOperator:
         with SeqAIJArrays(self.A, write=True) as (indptr, indices, a):
             cells.set_diagonal(indptr, indices, a, self._diagonal)
         self._state = self.A.stateGet()
+        self._keep_diagonal()
 
     def _assemble_split(self, assemble) -> None:
         from . import cells
@@ -683,6 +762,7 @@ class SymmetricBlockOperator:
             cells.set_diagonal(indptr, indices, a, self._diagonal)
         self.A.assemble()  # (its state changes: the smoothers read its diagonal)
         self._state = self.A.stateGet()
+        self._keep_diagonal()
 
     def sync(self) -> None:
         """A = S and its mirror image (A's pattern, lower triangle included), where S was assembled
@@ -700,6 +780,7 @@ class SymmetricBlockOperator:
             destroy(full, copy)
             self.upper_newer = False
             self._state = self.A.stateGet()
+            self._keep_diagonal()  # (A = S: its diagonal is S's)
             return
         from . import cells
 
@@ -710,6 +791,7 @@ class SymmetricBlockOperator:
         self._upper_values(mirror)
         self.upper_newer = False
         self._state = self.A.stateGet()
+        self._keep_diagonal()  # (A = S: its diagonal is S's)
 
     def diagonal(self) -> np.ndarray:
         """The diagonal of the tangent last assembled by :meth:`assemble_upper`: its diagonal
@@ -769,6 +851,9 @@ class SymmetricBlockOperator:
         if self._product is not None:
             self._product.forget()  # (before S is gone)
             self._product = None
+        if self._kept is not None:
+            self._kept.restore()
+            self._kept = None
         self.S.destroy()
         if self._split is not None:
             self._diagonal_vec.destroy()

@@ -1144,30 +1144,39 @@ int sbaij_mult(void* mat, void* x, void* y)
   return dc_restore(x, &px, y, &py);
 }
 
+/* mat's registration of `kind` (3, 5) and whether mat's object state is the one registered
+   (*current); 0 with *ierr set where there is none or the state cannot be read */
+static const dc_product_t* dc_stated(void* mat, int64_t kind, int* ierr, int* current)
+{
+  const dc_product_t* e = dc_product(mat, kind);
+  *ierr = 73; /* (never: the matrix's own operation is back before its registration ends) */
+  if (!e)
+    return 0;
+  int64_t state = -1;
+  if ((*ierr = dc_object_state(mat, &state)))
+    return 0;
+  *current = state == e->state;
+  return e;
+}
+
 /* MATOP_MULT of a matrix registered with a copy (kind 3) */
 int copied_mult(void* mat, void* x, void* y)
 {
-  const dc_product_t* e = dc_product(mat, 3);
+  int ierr, current;
+  const dc_product_t* e = dc_stated(mat, 3, &ierr, &current);
   if (!e)
-    return 73; /* (never: the matrix's own operation is back before its registration ends) */
-  int64_t state = -1;
-  int ierr = dc_object_state(mat, &state);
-  if (ierr)
     return ierr;
-  return state == e->state ? e->copy_mult(e->copy, x, y) : e->own_mult(mat, x, y);
+  return current ? e->copy_mult(e->copy, x, y) : e->own_mult(mat, x, y);
 }
 
 /* MATOP_GET_DIAGONAL of a matrix registered with a kept diagonal (kind 5) */
 int kept_diagonal(void* mat, void* d)
 {
-  const dc_product_t* e = dc_product(mat, 5);
+  int ierr, current;
+  const dc_product_t* e = dc_stated(mat, 5, &ierr, &current);
   if (!e)
-    return 73; /* (never: the matrix's own operation is back before its registration ends) */
-  int64_t state = -1;
-  int ierr = dc_object_state(mat, &state);
-  if (ierr)
     return ierr;
-  if (state != e->state)
+  if (!current)
     return ((int (*)(void*, void*))e->own_mult)(mat, d);
   double* pd;
   if ((ierr = dc_get_write(d, &pd)))

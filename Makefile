@@ -50,6 +50,7 @@ bench: setup
 	$(PY) benchmarks/hertz_same.py                 # Hertz, two equal elastic bodies (the peer comparison's set-up)
 	$(PY) benchmarks/pullout.py
 	$(PY) benchmarks/pullout_snap.py               # the pull-out's snap converged: about 8 minutes
+	$(PY) benchmarks/pullout_energy.py             # where the coarse quadrilaterals' excess energy lies
 	$(PY) benchmarks/beam_kernels.py               # the beams' C kernels against numba's, 10⁵ elements
 	$(PY) benchmarks/frame3d.py --sizes 7 15 32   # 10³, 10⁴, 10⁵ elements: about 20 minutes
 	$(PY) benchmarks/block3d.py                    # 116 k dofs SVK block: about 9 s

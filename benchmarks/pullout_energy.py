@@ -10,9 +10,10 @@ bending, on the strip of cells along the loaded generator (θ < 90°/n_θ, where
 folds) and on the rest; the QM6 membrane of the strip into ε_xx, ε_ss, their Poisson term,
 the in-plane shear γ_xs and the drilling penalty (x along the axis, s around the section).
 Cross-evaluation: each state is also evaluated with the other family's elements (the
-quadrilaterals' cells split along either diagonal into OPT + DKT triangles), and the OPT
-membrane on the triangles' state with its drilling rotations as computed, minimised cell by
-cell, and set to zero.
+quadrilaterals' cells split along either diagonal into OPT + DKT triangles, each in its own
+frame), with the cell's two OPT + DKT triangles in the four-node shell's frame (the triangles'
+law, the quadrilaterals' kinematics), and the OPT membrane on the triangles' state with its
+drilling rotations as computed, minimised cell by cell, and set to zero.
 
 Measured on 8 × 12 (strip / rest, 1/8 model; fine reference 32 × 48 quadrilaterals, P = 20 748,
 membrane 175 / 102, bending 1684 / 598):
@@ -20,18 +21,19 @@ membrane 175 / 102, bending 1684 / 598):
 | state | P | evaluated with | membrane | bending |
 |---|---|---|---|---|
 | quadrilaterals' | 21 776 | QM6 + DKQ | 185 / 107 | 1719 / 592 |
-| quadrilaterals' | | OPT + DKT (the mesh's diagonal) | 281 / 149 | 1747 / 612 |
-| triangles' | 19 683 | OPT + DKT | 183 / 112 | 1627 / 629 |
+| quadrilaterals' | | OPT + DKT (the mesh's diagonal), a frame per triangle | 281 / 149 | 1747 / 612 |
+| triangles' | 19 683 | OPT + DKT, a frame per triangle | 183 / 112 | 1627 / 629 |
 | triangles' | | QM6 + DKQ | 367 / 143 | 1618 / 617 |
+| triangles' | | OPT + DKT, one frame per cell | 425 / 134 | 1627 / 629 |
 
 On the same nodal values the DKQ is slightly softer than the DKT: bending is not where the
-quadrilaterals are stiff. The QM6 membrane doubles the strip's membrane energy of the
-triangles' state, all of it in-plane shear (γ_xs: 241 against 61 on its own state) in the
-cells next to the load; the OPT carries that state at 183 with its drilling rotations, at 849
-with them zeroed. So the coarse triangles take a membrane mode of the folding strip, in-plane
-shear near the load, through the OPT's drilling-enriched (quadratic-edge) membrane, which the
-bilinear membrane with incompatible modes cannot follow; the coarse quadrilaterals take the
-strip's fold in circumferential bending instead (+4.5 % of its converged energy) and snap late.
+quadrilaterals are stiff. Read in one frame per cell, the triangles' state strains the strip's
+membrane, with the QM6 (all of the difference in in-plane shear γ_xs: 241 against 61 on the
+quadrilaterals' own state) and just as much with the triangles' own law (425 against 183): the
+two triangles of a strip cell fold along their diagonal (up to 7.5° between their normals; the
+quadrilaterals' cells 4.9°), and a frame spanning the cell reads
+the fold's shortening of the other diagonal as in-plane shear. The family difference is the
+kinematics (a frame per triangle or per cell), not a law (docs/theory.md, "One frame per cell").
 
 Writes output/pullout_energy/{energy.json, energy.png}; the same numbers under ``mpirun -n 2``.
 Usage: python benchmarks/pullout_energy.py [--mesh 8 12] [--w 2.5] [--steps 25]
@@ -150,6 +152,37 @@ def triangle_energy(X, S):
     return em, 0.5 * d @ K @ d - em, 0.5 * d_min @ Km @ d_min, 0.5 * d_zero @ Km @ d_zero
 
 
+def pair_in_quad_frame_energy(X, S, halves):
+    """(membrane, bending) of the cell's two OPT + DKT triangles ``halves`` taken as one element
+    in the four-node shell's frame: the triangles' law, the quadrilateral's kinematics (d̄ from
+    :func:`frame_quad.shell_parts`, the triangles' stiffness assembled on x̄0, rigid links for the
+    initial warping as in the four-node law)."""
+    _, xbar0, d = _local(frame_quad, X, S)
+    K, Km, Kt = np.zeros((24, 24)), np.zeros((24, 24)), np.empty((18, 18))
+    for h in halves:
+        xy = np.ascontiguousarray(xbar0[h, :2])
+        dofs = np.array([6 * a + k for a in h for k in range(6)])
+        shell_triangle.local_stiffness(xy, TRI, Kt)
+        K[np.ix_(dofs, dofs)] += Kt
+        shell_triangle.local_stiffness(xy, TRI_MEMBRANE, Kt)
+        Km[np.ix_(dofs, dofs)] += Kt
+    W = np.eye(24)
+    for a in range(4):
+        W[6 * a, 6 * a + 4] = -xbar0[a, 2]
+        W[6 * a + 1, 6 * a + 3] = xbar0[a, 2]
+    em = 0.5 * d @ W.T @ Km @ W @ d
+    return em, 0.5 * d @ W.T @ K @ W @ d - em
+
+
+def fold_angle(X, S):
+    """The angle (degrees) between the current normals of the cell's triangles (0, 1, 3) and
+    (1, 2, 3): how far the cell folds along its diagonal 1-3 (a warped cell shows its twist)."""
+    x = X + S[:, :3]
+    n1 = np.cross(x[1] - x[0], x[3] - x[0])
+    n2 = np.cross(x[2] - x[1], x[3] - x[1])
+    return float(np.degrees(np.arccos(np.clip(n1 @ n2 / np.linalg.norm(n1) / np.linalg.norm(n2), -1.0, 1.0))))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--mesh", type=int, nargs=2, default=[8, 12])
@@ -162,8 +195,9 @@ def main():
     splits = {"diagonal 0-2": ([0, 1, 2], [0, 2, 3]), "diagonal 1-3": ([0, 1, 3], [1, 2, 3])}
     out = {"mesh": args.mesh, "w_A": args.w, "P": {"quadrilaterals": P_q, "triangles": P_t}}
     for name, state in (("quadrilaterals' state", state_q), ("triangles' state", state_t)):
-        sums = {"QM6 + DKQ": np.zeros((2, 2)), **{f"OPT + DKT, {k}": np.zeros((2, 2)) for k in splits}}
-        qm6_split, opt_drilling = np.zeros(5), np.zeros(3)
+        sums = {"QM6 + DKQ": np.zeros((2, 2)), **{f"OPT + DKT, {k}": np.zeros((2, 2)) for k in splits},
+                "OPT + DKT, diagonal 1-3, one frame": np.zeros((2, 2))}
+        qm6_split, opt_drilling, fold = np.zeros(5), np.zeros(3), 0.0
         for c in range(len(X)):
             Xc = np.ascontiguousarray(X[c][list(CCW)])
             strip = np.degrees(np.arctan2(Xc[:, 1].mean(), Xc[:, 2].mean())) < 90.0 / n_theta
@@ -173,6 +207,8 @@ def main():
             sums["QM6 + DKQ"][row] += em, eb
             if strip:
                 qm6_split += split
+                fold = max(fold, fold_angle(Xc, Sc))
+            sums["OPT + DKT, diagonal 1-3, one frame"][row] += pair_in_quad_frame_energy(Xc, Sc, splits["diagonal 1-3"])
             for key, halves in splits.items():
                 for h in halves:
                     tri = triangle_energy(np.ascontiguousarray(Xc[h]), np.ascontiguousarray(Sc[h]))
@@ -181,18 +217,21 @@ def main():
                         opt_drilling += tri[0], tri[2], tri[3]
         sums = {k: comm.allreduce(v) for k, v in sums.items()}
         qm6_split, opt_drilling = comm.allreduce(qm6_split), comm.allreduce(opt_drilling)
+        fold = comm.allreduce(fold, op=MPI.MAX)
         out[name] = {k: {"strip": {"membrane": v[0, 0], "bending": v[0, 1]},
                          "rest": {"membrane": v[1, 0], "bending": v[1, 1]}} for k, v in sums.items()}
         out[name]["QM6 strip membrane (exx, ess, poisson, gxs, drilling)"] = qm6_split.tolist()
         out[name]["OPT strip membrane (as computed, drilling minimised, drilling zero)"] = opt_drilling.tolist()
+        out[name]["largest fold of a strip cell along its diagonal 1-3 (degrees)"] = fold
         if comm.rank:
             continue
         print(f"{name}: P = {P_q if state is state_q else P_t:.1f}")
         for k, v in sums.items():
-            print(f"  {k:22s} strip: membrane {v[0, 0]:7.1f}, bending {v[0, 1]:7.1f}; "
+            print(f"  {k:34s} strip: membrane {v[0, 0]:7.1f}, bending {v[0, 1]:7.1f}; "
                   f"rest: membrane {v[1, 0]:7.1f}, bending {v[1, 1]:7.1f}; total {v.sum():7.1f}")
         print("  QM6 membrane of the strip (ε_xx, ε_ss, Poisson, γ_xs, drilling):", np.round(qm6_split, 1))
         print("  OPT membrane of the strip (as computed, drilling minimised, zero):", np.round(opt_drilling, 1))
+        print(f"  largest fold of a strip cell along its diagonal 1-3: {fold:.2f}°")
     out_dir = output_dir("pullout_energy")  # collective
     if comm.rank == 0:
         with open(os.path.join(out_dir, "energy.json"), "w") as f:

@@ -30,7 +30,10 @@
 # iterations for the step where the cap snaps on the middle mesh. The
 # quadrilaterals also converge from above, and more slowly on this doubly
 # curved shell (797, 772, 754 on the CI meshes: at the same nodes the
-# triangles are closer); on the middle mesh they cut the snapping step once.
+# triangles are closer, because a frame per triangle lets each cell fold along
+# its diagonal: the triangles' own law in one frame per four-node cell gives
+# 794 on 6 × 6, docs/theory.md, "One frame per cell"); on the middle mesh they
+# cut the snapping step once.
 #
 # Both families are run again with the shallow-shell local law
 # (`add_shell(..., shallow=True)`): each element's own bending strains its

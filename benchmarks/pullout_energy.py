@@ -89,6 +89,16 @@ def _local(frame, X, S):
     return R0, xbar0, parts(X, u, Rn, R0, xbar0)[-1]
 
 
+def rigid_links(xbar0):
+    """W (24, 24): the flat corners' dofs from the warped nodes' (u_p = u − zθy, v_p = v + zθx),
+    as in :func:`shell_quad.local_stiffness`."""
+    W = np.eye(24)
+    for a in range(4):
+        W[6 * a, 6 * a + 4] = -xbar0[a, 2]
+        W[6 * a + 1, 6 * a + 3] = xbar0[a, 2]
+    return W
+
+
 def quad_energy(X, S, props):
     """(membrane, bending, membrane split (ε_xx, ε_ss, Poisson, γ_xs, drilling)) of one
     four-node shell, counter-clockwise nodes X (4, 3), states S (4, 7)."""
@@ -101,10 +111,7 @@ def quad_energy(X, S, props):
     shell_quad.local_stiffness(xbar0, membrane, Km)
     em = 0.5 * d @ Km @ d
     # the membrane's strains at its 2 × 2 points, incompatible modes condensed as in the law
-    W = np.eye(24)
-    for a in range(4):
-        W[6 * a, 6 * a + 4] = -xbar0[a, 2]
-        W[6 * a + 1, 6 * a + 3] = xbar0[a, 2]
+    W = rigid_links(xbar0)
     xy = np.ascontiguousarray(xbar0[:, :2])
     A = props[shell_quad.A0:shell_quad.A0 + 9].reshape(3, 3)
     kd = props[shell_quad.ALPHA] * A[2, 2]
@@ -166,10 +173,7 @@ def pair_in_quad_frame_energy(X, S, halves):
         K[np.ix_(dofs, dofs)] += Kt
         shell_triangle.local_stiffness(xy, TRI_MEMBRANE, Kt)
         Km[np.ix_(dofs, dofs)] += Kt
-    W = np.eye(24)
-    for a in range(4):
-        W[6 * a, 6 * a + 4] = -xbar0[a, 2]
-        W[6 * a + 1, 6 * a + 3] = xbar0[a, 2]
+    W = rigid_links(xbar0)
     em = 0.5 * d @ W.T @ Km @ W @ d
     return em, 0.5 * d @ W.T @ K @ W @ d - em
 
